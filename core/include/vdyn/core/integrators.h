@@ -1,0 +1,41 @@
+#pragma once
+// Integrator choice by name. All six are Simbody's error-controlled integrators:
+//   rk_merson             Runge-Kutta-Merson, 4th order (Simbody's default)
+//   rk3                   Runge-Kutta 3rd order
+//   rk_feldberg           Runge-Kutta-Fehlberg 4(5)
+//   cpodes                CPodes variable-order BDF (implicit, for stiff scenes)
+//   verlet                velocity Verlet, 2nd order with error estimate
+//   semi_explicit_euler2  semi-explicit Euler with 2nd-order error estimate
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "vdyn/core/params.h"
+
+namespace vdyn {
+
+struct IntegratorSettings {
+  std::string method = "rk_merson";
+  /// Relative accuracy of the integration (dimensionless), in (0, 1).
+  double accuracy = 1e-6;
+  /// Tolerance on constraint errors (position: m for loop closures; velocity: m/s).
+  double constraint_tolerance = 1e-10;
+  /// Largest step the integrator may take, s; 0 = no limit.
+  double max_step_s = 0.0;
+
+  void validate() const;
+  /// Keys: method, accuracy, constraint_tolerance, max_step_s (all optional).
+  static IntegratorSettings fromParams(const ParamReader& r, IntegratorSettings defaults);
+  static IntegratorSettings fromParams(const ParamReader& r);
+};
+
+/// Names accepted by makeIntegrator, in a fixed order.
+const std::vector<std::string>& integratorNames();
+
+/// Creates the integrator; throws Error naming the method if it is unknown.
+std::unique_ptr<SimTK::Integrator> makeIntegrator(const SimTK::System& system,
+                                                  const IntegratorSettings& settings);
+
+}  // namespace vdyn

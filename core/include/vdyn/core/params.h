@@ -1,0 +1,65 @@
+#pragma once
+// Reading parameter structs from JSON data files.
+//
+// Convention (see README): every key that carries a physical quantity ends in
+// its SI unit, e.g. "mass_kg", "stiffness_N_per_m", "damping_N_s_per_m",
+// "position_m" (a 3-vector). A ParamReader names the file and the key path in
+// every error, e.g. "quarter_car.json: suspension.stiffness_N_per_m: missing key".
+// Loaders read into the same plain structs the C++ builders fill; range checks
+// live in each struct's validate(), so both paths are checked by one function.
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+#include <SimTKcommon.h>
+
+#include "vdyn/core/error.h"
+
+namespace vdyn {
+
+using Json = nlohmann::json;
+
+/// Reads and parses a JSON file; throws Error naming the file on I/O or syntax errors.
+Json readJsonFile(const std::string& path);
+
+/// Resolves a data-file name: an existing path is used as is, otherwise it is
+/// looked up in the project's data folder (vehicles/data).
+std::string resolveDataPath(const std::string& name);
+
+class ParamReader {
+ public:
+  /// `where` names the source in messages (file name, optionally key path).
+  ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where);
+  static ParamReader fromFile(const std::string& path);
+  static ParamReader fromJson(Json j, std::string where);
+
+  bool has(const std::string& key) const;
+  /// Required finite number.
+  double number(const std::string& key) const;
+  double numberOr(const std::string& key, double fallback) const;
+  SimTK::Vec3 vec3(const std::string& key) const;
+  SimTK::Vec3 vec3Or(const std::string& key, const SimTK::Vec3& fallback) const;
+  std::vector<double> numbers(const std::string& key) const;
+  std::string string(const std::string& key) const;
+  std::string stringOr(const std::string& key, const std::string& fallback) const;
+  bool boolean(const std::string& key) const;
+  bool booleanOr(const std::string& key, bool fallback) const;
+  int integer(const std::string& key) const;
+  ParamReader child(const std::string& key) const;
+  std::vector<ParamReader> array(const std::string& key) const;
+  const Json& json() const { return *node_; }
+  /// "file.json: a.b" style location of this node, for messages.
+  const std::string& where() const { return where_; }
+  /// Location of a key under this node.
+  std::string at(const std::string& key) const;
+
+ private:
+  const Json& require(const std::string& key) const;
+  std::shared_ptr<const Json> root_;
+  const Json* node_;
+  std::string where_;
+};
+
+}  // namespace vdyn

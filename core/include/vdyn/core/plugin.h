@@ -1,0 +1,79 @@
+#pragma once
+// Plugin interfaces. A plugin adds Simbody elements (forces, constraints,
+// measures, outputs) to a Scene. Following the Drake convention the public
+// methods are non-virtual: they validate, then call the protected Do...() hooks.
+#include <memory>
+#include <string>
+
+#include <Simbody.h>
+
+#include "vdyn/core/error.h"
+
+namespace vdyn {
+
+class Scene;
+
+enum class PluginKind { ForceElement, Constraint, Controller, Analysis };
+/// "force element", "constraint", ... as used in messages.
+const char* toString(PluginKind kind);
+
+class Plugin {
+ public:
+  virtual ~Plugin() = default;
+  Plugin(const Plugin&) = delete;
+  Plugin& operator=(const Plugin&) = delete;
+
+  PluginKind kind() const { return kind_; }
+  /// The registry type name ("gim", "steering", ...).
+  const std::string& type() const { return type_; }
+  /// The instance name within its scene ("tire_rf", ...); unique per scene.
+  const std::string& name() const { return name_; }
+
+  /// Adds the plugin's Simbody elements and outputs to `scene`. Called once, by
+  /// Scene::addPlugin, before the scene is finalized.
+  void addTo(Scene& scene);
+  /// Called by Scene::finalize on the new default state (initial values of the
+  /// plugin's own state, if any).
+  void initialize(const Scene& scene, SimTK::State& state) const;
+
+ protected:
+  Plugin(PluginKind kind, std::string type, std::string name);
+  virtual void DoAddTo(Scene& scene) = 0;
+  virtual void DoInitialize(const Scene&, SimTK::State&) const {}
+
+ private:
+  PluginKind kind_;
+  std::string type_;
+  std::string name_;
+  bool added_ = false;
+};
+
+/// A force element (tire, bushing, aerodynamic drag, ...).
+class ForceElementPlugin : public Plugin {
+ protected:
+  ForceElementPlugin(std::string type, std::string name)
+      : Plugin(PluginKind::ForceElement, std::move(type), std::move(name)) {}
+};
+
+/// A constraint or prescribed motion (steering, speed hold, ...).
+class ConstraintPlugin : public Plugin {
+ protected:
+  ConstraintPlugin(std::string type, std::string name)
+      : Plugin(PluginKind::Constraint, std::move(type), std::move(name)) {}
+};
+
+/// A controller producing commands from the state (path controller, rear steer).
+class ControllerPlugin : public Plugin {
+ protected:
+  ControllerPlugin(std::string type, std::string name)
+      : Plugin(PluginKind::Controller, std::move(type), std::move(name)) {}
+};
+
+/// An analysis run on a scene (steady state, sensitivity).
+class AnalysisPlugin : public Plugin {
+ protected:
+  AnalysisPlugin(std::string type, std::string name)
+      : Plugin(PluginKind::Analysis, std::move(type), std::move(name)) {}
+};
+
+}  // namespace vdyn

@@ -1,0 +1,38 @@
+#pragma once
+// Samples chosen scene outputs at report times. The simulation loop hands it the
+// integrator's interpolated states, so reporting never forces an integrator step.
+#include <string>
+#include <vector>
+
+#include "vdyn/core/scene.h"
+
+namespace vdyn {
+
+class Recorder {
+ public:
+  /// Records time plus the named outputs (each must exist in the scene).
+  Recorder(const Scene& scene, std::vector<std::string> outputNames);
+
+  /// Evaluates the outputs on `state`; realizes a copy if `state` is not yet
+  /// realized far enough (the integrator's state is const).
+  void record(const SimTK::State& state);
+
+  const std::vector<std::string>& names() const { return names_; }
+  std::size_t size() const { return time_.size(); }
+  const std::vector<double>& time() const { return time_; }
+  /// Column of one output; throws Error if it was not recorded.
+  const std::vector<double>& column(const std::string& name) const;
+  /// CSV with header "t_s,<name>[_unit]..." (output names carry their unit).
+  void writeCsv(const std::string& path) const;
+  void clear();
+
+ private:
+  const Scene& scene_;
+  std::vector<std::string> names_;
+  std::vector<const Output*> outputs_;
+  SimTK::Stage stage_ = SimTK::Stage::Time;
+  std::vector<double> time_;
+  std::vector<std::vector<double>> columns_;
+};
+
+}  // namespace vdyn

@@ -1,0 +1,45 @@
+#include "vdyn/core/error.h"
+
+#include <cstdio>
+
+namespace vdyn {
+
+std::string formatValue(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  // Prefer the shortest representation that round-trips.
+  for (int prec = 1; prec <= 17; ++prec) {
+    char b[64];
+    std::snprintf(b, sizeof b, "%.*g", prec, v);
+    if (std::strtod(b, nullptr) == v || std::isnan(v)) return b;
+  }
+  return buf;
+}
+
+double requireFinite(double v, const std::string& name) {
+  if (!std::isfinite(v))
+    throw Error(name + " must be a finite number, got " + formatValue(v));
+  return v;
+}
+
+double requirePositive(double v, const std::string& name) {
+  requireFinite(v, name);
+  if (!(v > 0)) throw Error(name + " must be positive, got " + formatValue(v));
+  return v;
+}
+
+double requireNonNegative(double v, const std::string& name) {
+  requireFinite(v, name);
+  if (v < 0) throw Error(name + " must not be negative, got " + formatValue(v));
+  return v;
+}
+
+double requireInRange(double v, double lo, double hi, const std::string& name) {
+  requireFinite(v, name);
+  if (v < lo || v > hi)
+    throw Error(name + " must lie in [" + formatValue(lo) + ", " + formatValue(hi) +
+                "], got " + formatValue(v));
+  return v;
+}
+
+}  // namespace vdyn

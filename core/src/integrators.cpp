@@ -1,0 +1,56 @@
+#include "vdyn/core/integrators.h"
+
+namespace vdyn {
+
+const std::vector<std::string>& integratorNames() {
+  static const std::vector<std::string> names = {"rk_merson", "rk3", "rk_feldberg",
+                                                 "cpodes", "verlet", "semi_explicit_euler2"};
+  return names;
+}
+
+void IntegratorSettings::validate() const {
+  bool known = false;
+  std::string list;
+  for (const auto& n : integratorNames()) {
+    known |= (n == method);
+    list += (list.empty() ? "" : ", ") + n;
+  }
+  if (!known) throw Error("unknown integrator '" + method + "'; known: " + list);
+  requireFinite(accuracy, "integrator accuracy");
+  if (!(accuracy > 0 && accuracy < 1))
+    throw Error("integrator accuracy must lie in (0, 1), got " + formatValue(accuracy));
+  requirePositive(constraint_tolerance, "integrator constraint_tolerance");
+  requireNonNegative(max_step_s, "integrator max_step_s");
+}
+
+IntegratorSettings IntegratorSettings::fromParams(const ParamReader& r, IntegratorSettings d) {
+  d.method = r.stringOr("method", d.method);
+  d.accuracy = r.numberOr("accuracy", d.accuracy);
+  d.constraint_tolerance = r.numberOr("constraint_tolerance", d.constraint_tolerance);
+  d.max_step_s = r.numberOr("max_step_s", d.max_step_s);
+  d.validate();
+  return d;
+}
+
+IntegratorSettings IntegratorSettings::fromParams(const ParamReader& r) {
+  return fromParams(r, IntegratorSettings());
+}
+
+std::unique_ptr<SimTK::Integrator> makeIntegrator(const SimTK::System& system,
+                                                  const IntegratorSettings& s) {
+  s.validate();
+  std::unique_ptr<SimTK::Integrator> integ;
+  if (s.method == "rk_merson") integ.reset(new SimTK::RungeKuttaMersonIntegrator(system));
+  else if (s.method == "rk3") integ.reset(new SimTK::RungeKutta3Integrator(system));
+  else if (s.method == "rk_feldberg") integ.reset(new SimTK::RungeKuttaFeldbergIntegrator(system));
+  else if (s.method == "cpodes") integ.reset(new SimTK::CPodesIntegrator(system, SimTK::CPodes::BDF, SimTK::CPodes::Newton));
+  else if (s.method == "verlet") integ.reset(new SimTK::VerletIntegrator(system));
+  else if (s.method == "semi_explicit_euler2") integ.reset(new SimTK::SemiExplicitEuler2Integrator(system));
+  assert(integ);
+  integ->setAccuracy(s.accuracy);
+  integ->setConstraintTolerance(s.constraint_tolerance);
+  if (s.max_step_s > 0) integ->setMaximumStepSize(s.max_step_s);
+  return integ;
+}
+
+}  // namespace vdyn

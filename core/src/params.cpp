@@ -1,0 +1,130 @@
+#include "vdyn/core/params.h"
+
+#include <fstream>
+#include <sys/stat.h>
+
+namespace vdyn {
+
+Json readJsonFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw Error("cannot open data file '" + path + "'");
+  try {
+    return Json::parse(in, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::parse_error& e) {
+    throw Error("data file '" + path + "' is not valid JSON: " + e.what());
+  }
+}
+
+std::string resolveDataPath(const std::string& name) {
+  struct stat st;
+  if (stat(name.c_str(), &st) == 0) return name;
+  const std::string inData = std::string(VDYN_DATA_DIR) + "/" + name;
+  if (stat(inData.c_str(), &st) == 0) return inData;
+  throw Error("data file '" + name + "' not found (looked in the working directory and " +
+              VDYN_DATA_DIR + ")");
+}
+
+ParamReader::ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where)
+    : root_(std::move(root)), node_(node), where_(std::move(where)) {
+  if (!node_->is_object()) throw Error(where_ + ": expected an object");
+}
+
+ParamReader ParamReader::fromFile(const std::string& path) {
+  const std::string resolved = resolveDataPath(path);
+  auto root = std::make_shared<const Json>(readJsonFile(resolved));
+  const std::string base = resolved.substr(resolved.find_last_of('/') + 1);
+  return ParamReader(root, root.get(), base + ":");
+}
+
+ParamReader ParamReader::fromJson(Json j, std::string where) {
+  auto root = std::make_shared<const Json>(std::move(j));
+  return ParamReader(root, root.get(), std::move(where) + ":");
+}
+
+std::string ParamReader::at(const std::string& key) const {
+  if (!where_.empty() && where_.back() == ':') return where_ + " " + key;
+  return where_ + "." + key;
+}
+
+bool ParamReader::has(const std::string& key) const { return node_->contains(key); }
+
+const Json& ParamReader::require(const std::string& key) const {
+  auto it = node_->find(key);
+  if (it == node_->end()) throw Error(at(key) + ": missing key");
+  return *it;
+}
+
+static double asNumber(const Json& v, const std::string& where) {
+  if (!v.is_number())
+    throw Error(where + ": expected a number, got " + std::string(v.type_name()) + " " + v.dump());
+  return requireFinite(v.get<double>(), where);
+}
+
+double ParamReader::number(const std::string& key) const { return asNumber(require(key), at(key)); }
+
+double ParamReader::numberOr(const std::string& key, double fallback) const {
+  return has(key) ? number(key) : fallback;
+}
+
+std::vector<double> ParamReader::numbers(const std::string& key) const {
+  const Json& v = require(key);
+  if (!v.is_array()) throw Error(at(key) + ": expected an array of numbers, got " + v.dump());
+  std::vector<double> out;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out.push_back(asNumber(v[i], at(key) + "[" + std::to_string(i) + "]"));
+  return out;
+}
+
+SimTK::Vec3 ParamReader::vec3(const std::string& key) const {
+  const auto v = numbers(key);
+  if (v.size() != 3)
+    throw Error(at(key) + ": expected 3 numbers [x, y, z], got " + std::to_string(v.size()));
+  return SimTK::Vec3(v[0], v[1], v[2]);
+}
+
+SimTK::Vec3 ParamReader::vec3Or(const std::string& key, const SimTK::Vec3& fallback) const {
+  return has(key) ? vec3(key) : fallback;
+}
+
+std::string ParamReader::string(const std::string& key) const {
+  const Json& v = require(key);
+  if (!v.is_string()) throw Error(at(key) + ": expected a string, got " + v.dump());
+  return v.get<std::string>();
+}
+
+std::string ParamReader::stringOr(const std::string& key, const std::string& fallback) const {
+  return has(key) ? string(key) : fallback;
+}
+
+bool ParamReader::boolean(const std::string& key) const {
+  const Json& v = require(key);
+  if (!v.is_boolean()) throw Error(at(key) + ": expected true or false, got " + v.dump());
+  return v.get<bool>();
+}
+
+bool ParamReader::booleanOr(const std::string& key, bool fallback) const {
+  return has(key) ? boolean(key) : fallback;
+}
+
+int ParamReader::integer(const std::string& key) const {
+  const Json& v = require(key);
+  if (!v.is_number_integer()) throw Error(at(key) + ": expected an integer, got " + v.dump());
+  return v.get<int>();
+}
+
+ParamReader ParamReader::child(const std::string& key) const {
+  const Json& v = require(key);
+  if (!v.is_object()) throw Error(at(key) + ": expected an object, got " + v.dump());
+  return ParamReader(root_, &v, at(key));
+}
+
+std::vector<ParamReader> ParamReader::array(const std::string& key) const {
+  const Json& v = require(key);
+  if (!v.is_array()) throw Error(at(key) + ": expected an array, got " + v.dump());
+  std::vector<ParamReader> out;
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out.emplace_back(root_, &v[i], at(key) + "[" + std::to_string(i) + "]");
+  return out;
+}
+
+}  // namespace vdyn

@@ -1,0 +1,58 @@
+#include "vdyn/core/recorder.h"
+
+#include <cstdio>
+#include <fstream>
+
+namespace vdyn {
+
+Recorder::Recorder(const Scene& scene, std::vector<std::string> names)
+    : scene_(scene), names_(std::move(names)) {
+  for (const auto& n : names_) {
+    outputs_.push_back(&scene_.getOutput(n));
+    if (outputs_.back()->stage > stage_) stage_ = outputs_.back()->stage;
+  }
+  columns_.resize(names_.size());
+}
+
+void Recorder::record(const SimTK::State& state) {
+  const SimTK::State* s = &state;
+  SimTK::State copy;
+  if (state.getSystemStage() < stage_) {
+    copy = state;
+    scene_.getSystem().realize(copy, stage_);
+    s = &copy;
+  }
+  time_.push_back(s->getTime());
+  for (std::size_t i = 0; i < outputs_.size(); ++i) columns_[i].push_back(outputs_[i]->eval(*s));
+}
+
+const std::vector<double>& Recorder::column(const std::string& name) const {
+  for (std::size_t i = 0; i < names_.size(); ++i)
+    if (names_[i] == name) return columns_[i];
+  throw Error("recorder has no column '" + name + "'");
+}
+
+void Recorder::writeCsv(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write '" + path + "'");
+  out << "t_s";
+  for (const auto& n : names_) out << ',' << n;
+  out << '\n';
+  char buf[32];
+  for (std::size_t r = 0; r < time_.size(); ++r) {
+    std::snprintf(buf, sizeof buf, "%.9g", time_[r]);
+    out << buf;
+    for (const auto& c : columns_) {
+      std::snprintf(buf, sizeof buf, "%.12g", c[r]);
+      out << ',' << buf;
+    }
+    out << '\n';
+  }
+}
+
+void Recorder::clear() {
+  time_.clear();
+  for (auto& c : columns_) c.clear();
+}
+
+}  // namespace vdyn

@@ -1,0 +1,97 @@
+#include "vdyn/core/simulation.h"
+
+#include <chrono>
+#include <cmath>
+
+namespace vdyn {
+
+void SimulationSettings::validate() const {
+  requireFinite(t_end_s, "simulation t_end_s");
+  requireNonNegative(report_interval_s, "simulation report_interval_s");
+  integrator.validate();
+}
+
+double positionConstraintError(const SimTK::State& state) {
+  const SimTK::Vector& qerr = state.getQErr();
+  return qerr.size() ? qerr.normInf() : 0.0;
+}
+
+void resetIntegrals(const Scene& scene, SimTK::State& state) {
+  // Integrals live in the force subsystem's z variables and start at zero; the
+  // only z's a Scene allocates are those integrals.
+  scene.getForces().updZ(state) = 0;
+}
+
+RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& s,
+                    Recorder* recorder, const std::function<void(const SimTK::State&)>& afterStep) {
+  if (!scene.isFinalized())
+    throw Error("simulate: the scene changed after the state was made; make the state again");
+  s.validate();
+  const double t0 = state.getTime();
+  if (!(s.t_end_s > t0))
+    throw Error("simulate: t_end_s (" + formatValue(s.t_end_s) + ") must be after the start time " +
+                formatValue(t0));
+  if (s.reset_integrals) resetIntegrals(scene, state);
+
+  RunSummary sum;
+  sum.integrator = s.integrator.method;
+  sum.accuracy = s.integrator.accuracy;
+  const auto wall0 = std::chrono::steady_clock::now();
+
+  auto integ = makeIntegrator(scene.getSystem(), s.integrator);
+  integ->setReturnEveryInternalStep(true);
+  integ->setFinalTime(s.t_end_s);
+  try {
+    integ->initialize(state);
+  } catch (const std::exception& e) {
+    throw Error(std::string("simulate: initializing ") + s.integrator.method + " failed: " + e.what());
+  }
+  sum.max_constraint_error = positionConstraintError(integ->getState());
+
+  const bool reporting = recorder && s.report_interval_s > 0;
+  long k = 1;  // index of the next report time t0 + k * dt (no accumulated drift)
+  auto nextReport = [&] { return std::min(s.t_end_s, t0 + k * s.report_interval_s); };
+  if (reporting) recorder->record(integ->getState());
+  double lastReported = t0;
+
+  for (;;) {
+    SimTK::Integrator::SuccessfulStepStatus status;
+    try {
+      status = integ->stepTo(reporting ? nextReport() : s.t_end_s);
+    } catch (const std::exception& e) {
+      throw Error("simulate: " + s.integrator.method + " failed at t = " +
+                  formatValue(integ->getTime()) + " s: " + e.what());
+    }
+    using S = SimTK::Integrator;
+    if (status == S::TimeHasAdvanced) {
+      const SimTK::State& adv = integ->getAdvancedState();
+      sum.max_constraint_error = std::max(sum.max_constraint_error, positionConstraintError(adv));
+      if (afterStep) afterStep(adv);
+    } else if (status == S::ReachedReportTime) {
+      if (reporting) {
+        recorder->record(integ->getState());
+        lastReported = integ->getTime();
+        ++k;
+      }
+    } else if (status == S::EndOfSimulation) {
+      if (reporting && integ->getTime() > lastReported + 1e-12) recorder->record(integ->getState());
+      break;
+    }
+  }
+  if (integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
+    throw Error("simulate: " + s.integrator.method + " stopped early at t = " +
+                formatValue(integ->getTime()) + " s (" +
+                SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");
+
+  state = integ->getState();
+  sum.steps = integ->getNumStepsTaken();
+  sum.attempts = integ->getNumStepsAttempted();
+  sum.realizations = integ->getNumRealizations();
+  sum.projections = integ->getNumProjections();
+  sum.sim_time_s = s.t_end_s - t0;
+  sum.wall_time_s =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  return sum;
+}
+
+}  // namespace vdyn

@@ -1,0 +1,87 @@
+#pragma once
+// The tire as a Simbody force element on a wheel body, and its plugin.
+#include <memory>
+#include <string>
+
+#include <Simbody.h>
+
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+#include "vdyn/tire/road.h"
+#include "vdyn/tire/tire_model.h"
+
+namespace vdyn {
+
+/// Contact geometry, kinematics and forces of one tire at one state.
+struct TireContact {
+  bool in_contact = false;
+  SimTK::Vec3 p_GC;          ///< contact point on the road, in G, m
+  SimTK::Rotation R_GC;      ///< contact frame C (x heading, y lateral, z normal) in G
+  ContactKinematics kinematics;
+  TireForces forces;         ///< in C, acting on the wheel
+};
+
+/// Force::Custom implementation: wheel W (origin at the wheel centre, spin axis
+/// `spinAxis_W`), a torus of radii R1, R2 against the road height field.
+class TireForceImpl : public SimTK::Force::Custom::Implementation {
+ public:
+  TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
+                std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W);
+
+  /// Needs Stage::Velocity (and Time) realized.
+  TireContact calcContact(const SimTK::State& state) const;
+
+  void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& bodyForces,
+                 SimTK::Vector_<SimTK::Vec3>& particleForces, SimTK::Vector& mobilityForces) const override;
+  /// Elastic energy of the radial spring (so Simbody's calcEnergy conserves).
+  SimTK::Real calcPotentialEnergy(const SimTK::State& state) const override;
+
+  const TireModel& getModel() const { return *model_; }
+
+ private:
+  struct Geometry {
+    bool in_contact = false;
+    SimTK::Vec3 p_GC{0};
+    SimTK::Rotation R_GC{};
+    double deflection = 0, camber = 0;
+  };
+  /// Geometry only (Stage::Position): contact point, frame, deflection.
+  Geometry calcGeometry(const SimTK::State& s) const;
+
+  SimTK::MobilizedBody wheel_;
+  std::shared_ptr<const TireModel> model_;
+  std::shared_ptr<const Road> road_;
+  SimTK::UnitVec3 spinAxis_W_;
+};
+
+/// Tire plugin: attaches a TireModel to a named wheel body of the scene, on the
+/// scene's "road" service. Outputs (per instance name N): N.Fx_N, N.Fy_N, N.Fz_N,
+/// N.Mz_N_m, N.deflection_m, N.slip_ratio, N.slip_angle_rad.
+class TirePlugin : public ForceElementPlugin {
+ public:
+  TirePlugin(std::string type, std::string name, std::string wheelBody,
+             std::shared_ptr<const TireModel> model,
+             SimTK::UnitVec3 spinAxis_W = SimTK::UnitVec3(SimTK::YAxis),
+             std::string roadService = "road");
+
+  /// Valid after the plugin was added to a scene.
+  const TireForceImpl& getForceElement() const;
+  TireContact calcContact(const SimTK::State& s) const { return getForceElement().calcContact(s); }
+  const std::string& wheelBody() const { return wheelBody_; }
+
+ protected:
+  void DoAddTo(Scene& scene) override;
+
+ private:
+  std::string wheelBody_;
+  std::shared_ptr<const TireModel> model_;
+  SimTK::UnitVec3 spinAxis_W_;
+  std::string roadService_;
+  const TireForceImpl* impl_ = nullptr;  // owned by the Simbody force subsystem
+};
+
+/// Registers the tire plugins "gim", "fiala" and "linear". Parameters:
+/// {"wheel": "<body name>", "params": {TireParams keys}}.
+void registerTirePlugins(PluginRegistry& registry);
+
+}  // namespace vdyn

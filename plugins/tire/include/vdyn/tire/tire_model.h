@@ -1,0 +1,133 @@
+#pragma once
+// Tire force laws, callable on their own: contact kinematics in, forces and
+// moments out, in the contact frame C:
+//   x_C  wheel heading (spin axis x road normal), forward
+//   y_C  lateral, to the left of the heading (in the road plane)
+//   z_C  road normal, up
+// Forces act on the wheel at the contact point; they oppose the slip velocity
+// of the contact patch (V_x - Omega Re, V_y).
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "vdyn/core/params.h"
+
+namespace vdyn {
+
+/// Parameters shared by all tire models (Table A.4 of the seed gives radius,
+/// radial stiffness, C_s, C_a, mu_max, mu_min; the others are not given there).
+struct TireParams {
+  double unloaded_radius_m = 0.30;              ///< R1, torus outer radius
+  double carcass_radius_m = 0.0;                ///< R2, torus tube radius (0 = thin disc)
+  double radial_stiffness_N_per_m = 1.5e5;      ///< Kz (the seed's C_z)
+  double radial_damping_N_s_per_m = 400.0;      ///< Cz; not in the seed (about 0.1 of critical for 25 kg unsprung)
+  double longitudinal_stiffness_N = 8.0e4;      ///< C_s, N per unit slip ratio
+  double cornering_stiffness_N_per_rad = 7.0e4; ///< C_a, N/rad
+  double camber_stiffness_N_per_rad = 0.0;      ///< C_g; camber thrust C_g * gamma at small slip (not in the seed)
+  double mu_max = 0.80;                         ///< friction coefficient at zero comprehensive slip
+  double mu_min = 0.60;                         ///< friction coefficient at full sliding (S = 1)
+  double rolling_resistance_coefficient = 0.0;  ///< My = -c Fz Re (against the spin); not in the seed
+  /// Speed below which slip denominators are held at this value, m/s: slips stay
+  /// finite at standstill and the tire acts as a stiff damper there.
+  double low_speed_threshold_m_s = 0.5;
+
+  /// Throws Error naming `where`.field and the value for a non-physical value.
+  void validate(const std::string& where = "tire") const;
+  /// Keys are the field names above; missing keys keep the defaults.
+  static TireParams fromParams(const ParamReader& r);
+  /// The same keys, for data files and for plugin factories.
+  Json toJson() const;
+  /// The one list of (key, member) pairs that fromParams and toJson use.
+  using Field = std::pair<const char*, double TireParams::*>;
+  static const std::vector<Field>& fields();
+};
+
+/// Kinematics of the contact, computed by the force element (or given by a test).
+struct ContactKinematics {
+  double deflection_m = 0;         ///< radial deflection delta along the normal, >= 0 in contact
+  double deflection_rate_m_s = 0;  ///< d delta / dt
+  double vx_m_s = 0;               ///< wheel-centre velocity along x_C
+  double vy_m_s = 0;               ///< wheel-centre velocity along y_C
+  double spin_rad_s = 0;           ///< wheel spin about its axis, > 0 rolling forward
+  double camber_rad = 0;           ///< > 0 when the wheel top leans toward +y_C
+};
+
+/// Forces on the wheel in C, and slip diagnostics.
+struct TireForces {
+  double fx_N = 0, fy_N = 0, fz_N = 0;  ///< force at the contact point
+  double my_N_m = 0;                    ///< rolling-resistance moment about the spin axis
+  double mz_N_m = 0;                    ///< aligning moment about z_C
+  double slip_ratio = 0;                ///< longitudinal slip, > 0 driving ((Omega Re - Vx)/den)
+  double slip_angle_rad = 0;            ///< atan(Vy / den), den = max(|Vx|, low-speed threshold)
+  double mu = 0;                        ///< friction coefficient used
+};
+
+class TireModel {
+ public:
+  virtual ~TireModel() = default;
+  const TireParams& params() const { return p_; }
+  /// Validates the kinematics (finite) and returns the forces; zero force and no
+  /// slip computation when the wheel is off the ground (deflection <= 0).
+  TireForces calcForces(const ContactKinematics& k) const;
+  /// Normal force Fz = max(0, Kz delta + Cz delta'), N.
+  double calcNormalForce(const ContactKinematics& k) const;
+  /// Effective rolling radius Re = R1 - delta / 3, m (derived: the usual
+  /// approximation for a radial tire between loaded and unloaded radius).
+  double calcRollingRadius(double deflection_m) const;
+  /// Elastic energy of the radial spring, Kz delta^2 / 2, J.
+  double calcPotentialEnergy(double deflection_m) const;
+
+ protected:
+  explicit TireModel(const TireParams& p);
+  /// Tangential forces and moments; called only in contact, with fz_N set.
+  virtual void DoCalcTangential(const ContactKinematics& k, TireForces& f) const = 0;
+
+  /// Slip velocities and regularized denominators shared by the models.
+  struct Slip {
+    double vr;      ///< rolling speed Omega Re
+    double vsx;     ///< longitudinal slip velocity Vx - Omega Re
+    double den_x;   ///< max(|Vx|, v_eps)
+    double sigma_y; ///< signed lateral slip: Vy / den_x - (C_g / C_a) sin(gamma)
+  };
+  Slip calcSlip(const ContactKinematics& k) const;
+  /// Friction coefficient falling linearly from mu_max (S = 0) to mu_min (S >= 1).
+  double calcFriction(double comprehensiveSlip) const;
+  /// Half contact length a = sqrt(delta (2 R1 - delta)), m.
+  double calcHalfContactLength(double deflection_m) const;
+
+  TireParams p_;
+};
+
+/// The seed's analytical comprehensive-slip tire (Gim and Nikravesh; DESIGN.md
+/// section 8): adhesion fraction l_n of the patch, adhesion and sliding parts.
+class GimTire : public TireModel {
+ public:
+  explicit GimTire(const TireParams& p) : TireModel(p) {}
+
+ protected:
+  void DoCalcTangential(const ContactKinematics& k, TireForces& f) const override;
+};
+
+/// The Fiala tire as published (DESIGN.md section 11).
+class FialaTire : public TireModel {
+ public:
+  explicit FialaTire(const TireParams& p) : TireModel(p) {}
+
+ protected:
+  void DoCalcTangential(const ContactKinematics& k, TireForces& f) const override;
+};
+
+/// Linear tire: Fx = C_s kappa, Fy = -C_a alpha, no saturation (linear bicycle bridge).
+class LinearTire : public TireModel {
+ public:
+  explicit LinearTire(const TireParams& p) : TireModel(p) {}
+
+ protected:
+  void DoCalcTangential(const ContactKinematics& k, TireForces& f) const override;
+};
+
+/// "gim", "fiala" or "linear"; throws Error listing the known models.
+std::shared_ptr<const TireModel> makeTireModel(const std::string& type, const TireParams& p);
+
+}  // namespace vdyn

@@ -1,0 +1,137 @@
+#include "vdyn/tire/tire_force.h"
+
+#include <cmath>
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+TireForceImpl::TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
+                             std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W)
+    : wheel_(wheel), model_(std::move(model)), road_(std::move(road)), spinAxis_W_(spinAxis_W) {
+  if (!model_) throw Error("tire force element: no tire model");
+  if (!road_) throw Error("tire force element: no road");
+}
+
+TireForceImpl::Geometry TireForceImpl::calcGeometry(const SimTK::State& s) const {
+  Geometry g;
+  const SimTK::Transform& X_GW = wheel_.getBodyTransform(s);
+  const Vec3& p_GW = X_GW.p();
+  const Vec3 s_G = X_GW.R() * Vec3(spinAxis_W_);
+  const double t = s.getTime();
+  const Vec3 n = Vec3(road_->normal(p_GW[0], p_GW[1], t));
+  // Direction in the wheel plane pointing most steeply into the road.
+  const double ns = SimTK::dot(n, s_G);
+  Vec3 down = -n + ns * s_G;
+  const double len = down.norm();
+  if (len < 1e-9) return g;  // wheel lying flat on the road: no rolling contact
+  down /= len;
+  const TireParams& p = model_->params();
+  const Vec3 p_GC0 = p_GW + (p.unloaded_radius_m - p.carcass_radius_m) * down;  // carcass centre
+  const double h = road_->height(p_GC0[0], p_GC0[1], t);
+  const double clearance = (p_GC0[2] - h) * n[2];  // height of C0 above the road along n
+  g.deflection = p.carcass_radius_m - clearance;
+  if (!(g.deflection > 0)) return g;
+  g.p_GC = p_GC0 - clearance * n;  // point on the road surface under the carcass centre
+  const Vec3 x = SimTK::cross(s_G, n) / len;  // heading (|s x n| = len)
+  g.R_GC = SimTK::Rotation(SimTK::Mat33(x, SimTK::cross(n, x), n), true);
+  g.camber = std::asin(std::max(-1.0, std::min(1.0, -ns)));
+  g.in_contact = true;
+  return g;
+}
+
+TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
+  TireContact c;
+  const Geometry g = calcGeometry(s);
+  if (!g.in_contact) return c;
+  c.in_contact = true;
+  c.p_GC = g.p_GC;
+  c.R_GC = g.R_GC;
+  const double deflection = g.deflection, camber = g.camber;
+  const Vec3 p_GW = wheel_.getBodyOriginLocation(s);
+  const Vec3 v_GW = wheel_.getBodyOriginVelocity(s);
+  const Vec3 w_GW = wheel_.getBodyAngularVelocity(s);
+  const Vec3 s_G = wheel_.getBodyRotation(s) * Vec3(spinAxis_W_);
+  const Vec3 n = c.R_GC.z();
+  // Velocity of the wheel material point at the contact point; its normal
+  // component is the rate of change of the deflection (the contact point is an
+  // extremum of the wheel's height, so its material and geometric rates agree).
+  const Vec3 v_GP = v_GW + SimTK::cross(w_GW, c.p_GC - p_GW);
+  ContactKinematics& k = c.kinematics;
+  k.deflection_m = deflection;
+  k.deflection_rate_m_s = -(SimTK::dot(v_GP, n) - road_->heightRate(c.p_GC[0], c.p_GC[1], s.getTime()));
+  k.vx_m_s = SimTK::dot(v_GW, c.R_GC.x());
+  k.vy_m_s = SimTK::dot(v_GW, c.R_GC.y());
+  k.spin_rad_s = SimTK::dot(w_GW, s_G);
+  k.camber_rad = camber;
+  c.forces = model_->calcForces(k);
+  return c;
+}
+
+void TireForceImpl::calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>& bodyForces,
+                              SimTK::Vector_<Vec3>&, SimTK::Vector&) const {
+  const TireContact c = calcContact(s);
+  if (!c.in_contact) return;
+  const TireForces& f = c.forces;
+  const Vec3 F_G = c.R_GC * Vec3(f.fx_N, f.fy_N, f.fz_N);
+  const Vec3 s_G = wheel_.getBodyRotation(s) * Vec3(spinAxis_W_);
+  const Vec3 M_G = f.mz_N_m * c.R_GC.z() + f.my_N_m * s_G;
+  const Vec3 r_GP = c.p_GC - wheel_.getBodyOriginLocation(s);
+  bodyForces[wheel_.getMobilizedBodyIndex()] += SimTK::SpatialVec(M_G + SimTK::cross(r_GP, F_G), F_G);
+}
+
+SimTK::Real TireForceImpl::calcPotentialEnergy(const SimTK::State& s) const {
+  const Geometry g = calcGeometry(s);
+  return g.in_contact ? model_->calcPotentialEnergy(g.deflection) : 0.0;
+}
+
+// ---------------------------------------------------------------------------
+TirePlugin::TirePlugin(std::string type, std::string name, std::string wheelBody,
+                       std::shared_ptr<const TireModel> model, SimTK::UnitVec3 spinAxis_W,
+                       std::string roadService)
+    : ForceElementPlugin(std::move(type), std::move(name)),
+      wheelBody_(std::move(wheelBody)),
+      model_(std::move(model)),
+      spinAxis_W_(spinAxis_W),
+      roadService_(std::move(roadService)) {
+  if (!model_) throw Error("tire plugin '" + this->name() + "': no tire model");
+}
+
+const TireForceImpl& TirePlugin::getForceElement() const {
+  if (!impl_) throw Error("tire plugin '" + name() + "' is not part of a scene yet");
+  return *impl_;
+}
+
+void TirePlugin::DoAddTo(Scene& scene) {
+  const SimTK::MobilizedBody& wheel = scene.getBody(wheelBody_);
+  auto road = scene.getService<const Road>(roadService_);
+  auto* impl = new TireForceImpl(wheel, model_, road, spinAxis_W_);
+  SimTK::Force::Custom(scene.updForces(), impl);  // the subsystem owns impl
+  impl_ = impl;
+  const TireForceImpl* e = impl;
+  auto add = [&](const std::string& q, const std::string& unit, auto get) {
+    scene.addOutput(Output{name() + "." + q, unit, SimTK::Stage::Velocity,
+                           [e, get](const SimTK::State& s) { return get(e->calcContact(s)); }});
+  };
+  add("Fx_N", "N", [](const TireContact& c) { return c.forces.fx_N; });
+  add("Fy_N", "N", [](const TireContact& c) { return c.forces.fy_N; });
+  add("Fz_N", "N", [](const TireContact& c) { return c.forces.fz_N; });
+  add("Mz_N_m", "N m", [](const TireContact& c) { return c.forces.mz_N_m; });
+  add("deflection_m", "m", [](const TireContact& c) { return c.kinematics.deflection_m; });
+  add("slip_ratio", "1", [](const TireContact& c) { return c.forces.slip_ratio; });
+  add("slip_angle_rad", "rad", [](const TireContact& c) { return c.forces.slip_angle_rad; });
+}
+
+void registerTirePlugins(PluginRegistry& registry) {
+  for (const char* type : {"gim", "fiala", "linear"}) {
+    registry.add(PluginKind::ForceElement, type, [type](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+      const TireParams p = spec.params.has("params") ? TireParams::fromParams(spec.params.child("params"))
+                                                     : TireParams{};
+      return std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"),
+                                          makeTireModel(type, p),
+                                          SimTK::UnitVec3(spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0))));
+    });
+  }
+}
+
+}  // namespace vdyn

@@ -1,0 +1,198 @@
+#include "vdyn/tire/tire_model.h"
+
+#include <algorithm>
+#include <cmath>
+
+namespace vdyn {
+
+namespace {
+double sgn(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+}  // namespace
+
+void TireParams::validate(const std::string& w) const {
+  requirePositive(unloaded_radius_m, w + ".unloaded_radius_m");
+  requireNonNegative(carcass_radius_m, w + ".carcass_radius_m");
+  if (!(carcass_radius_m < unloaded_radius_m))
+    throw Error(w + ".carcass_radius_m must be smaller than unloaded_radius_m, got " +
+                formatValue(carcass_radius_m));
+  requirePositive(radial_stiffness_N_per_m, w + ".radial_stiffness_N_per_m");
+  requireNonNegative(radial_damping_N_s_per_m, w + ".radial_damping_N_s_per_m");
+  requireNonNegative(longitudinal_stiffness_N, w + ".longitudinal_stiffness_N");
+  requireNonNegative(cornering_stiffness_N_per_rad, w + ".cornering_stiffness_N_per_rad");
+  requireNonNegative(camber_stiffness_N_per_rad, w + ".camber_stiffness_N_per_rad");
+  requireNonNegative(mu_max, w + ".mu_max");
+  requireNonNegative(mu_min, w + ".mu_min");
+  if (mu_min > mu_max)
+    throw Error(w + ".mu_min (" + formatValue(mu_min) + ") must not exceed mu_max (" +
+                formatValue(mu_max) + ")");
+  requireNonNegative(rolling_resistance_coefficient, w + ".rolling_resistance_coefficient");
+  requirePositive(low_speed_threshold_m_s, w + ".low_speed_threshold_m_s");
+}
+
+const std::vector<TireParams::Field>& TireParams::fields() {
+  static const std::vector<Field> f = {
+      {"unloaded_radius_m", &TireParams::unloaded_radius_m},
+      {"carcass_radius_m", &TireParams::carcass_radius_m},
+      {"radial_stiffness_N_per_m", &TireParams::radial_stiffness_N_per_m},
+      {"radial_damping_N_s_per_m", &TireParams::radial_damping_N_s_per_m},
+      {"longitudinal_stiffness_N", &TireParams::longitudinal_stiffness_N},
+      {"cornering_stiffness_N_per_rad", &TireParams::cornering_stiffness_N_per_rad},
+      {"camber_stiffness_N_per_rad", &TireParams::camber_stiffness_N_per_rad},
+      {"mu_max", &TireParams::mu_max},
+      {"mu_min", &TireParams::mu_min},
+      {"rolling_resistance_coefficient", &TireParams::rolling_resistance_coefficient},
+      {"low_speed_threshold_m_s", &TireParams::low_speed_threshold_m_s},
+  };
+  return f;
+}
+
+TireParams TireParams::fromParams(const ParamReader& r) {
+  TireParams p;
+  for (const auto& [key, member] : fields()) p.*member = r.numberOr(key, p.*member);
+  for (auto it = r.json().begin(); it != r.json().end(); ++it) {
+    bool known = false;
+    for (const auto& f : fields()) known |= (it.key() == f.first);
+    if (!known && it.key().rfind("_", 0) != 0) throw Error(r.at(it.key()) + ": unknown tire parameter");
+  }
+  p.validate(r.where());
+  return p;
+}
+
+Json TireParams::toJson() const {
+  Json j = Json::object();
+  for (const auto& [key, member] : fields()) j[key] = this->*member;
+  return j;
+}
+
+TireModel::TireModel(const TireParams& p) : p_(p) { p_.validate(); }
+
+double TireModel::calcNormalForce(const ContactKinematics& k) const {
+  if (!(k.deflection_m > 0)) return 0.0;
+  return std::max(0.0, p_.radial_stiffness_N_per_m * k.deflection_m +
+                           p_.radial_damping_N_s_per_m * k.deflection_rate_m_s);
+}
+
+double TireModel::calcRollingRadius(double d) const { return p_.unloaded_radius_m - std::max(0.0, d) / 3.0; }
+
+double TireModel::calcPotentialEnergy(double d) const {
+  return d > 0 ? 0.5 * p_.radial_stiffness_N_per_m * d * d : 0.0;
+}
+
+double TireModel::calcHalfContactLength(double d) const {
+  const double dd = std::min(std::max(0.0, d), p_.unloaded_radius_m);
+  return std::sqrt(dd * (2 * p_.unloaded_radius_m - dd));
+}
+
+double TireModel::calcFriction(double S) const {
+  const double s = std::min(1.0, std::max(0.0, S));
+  return p_.mu_max - (p_.mu_max - p_.mu_min) * s;
+}
+
+TireModel::Slip TireModel::calcSlip(const ContactKinematics& k) const {
+  Slip s;
+  s.vr = k.spin_rad_s * calcRollingRadius(k.deflection_m);
+  s.vsx = k.vx_m_s - s.vr;
+  s.den_x = std::max(std::abs(k.vx_m_s), p_.low_speed_threshold_m_s);
+  s.sigma_y = k.vy_m_s / s.den_x;
+  if (p_.camber_stiffness_N_per_rad > 0 && p_.cornering_stiffness_N_per_rad > 0)
+    s.sigma_y -= p_.camber_stiffness_N_per_rad / p_.cornering_stiffness_N_per_rad * std::sin(k.camber_rad);
+  return s;
+}
+
+TireForces TireModel::calcForces(const ContactKinematics& k) const {
+  requireFinite(k.deflection_m, "tire contact deflection_m");
+  requireFinite(k.deflection_rate_m_s, "tire contact deflection_rate_m_s");
+  requireFinite(k.vx_m_s, "tire contact vx_m_s");
+  requireFinite(k.vy_m_s, "tire contact vy_m_s");
+  requireFinite(k.spin_rad_s, "tire contact spin_rad_s");
+  requireFinite(k.camber_rad, "tire contact camber_rad");
+  TireForces f;
+  f.fz_N = calcNormalForce(k);
+  if (f.fz_N <= 0) return f;  // off the ground: no slip computation
+  DoCalcTangential(k, f);
+  if (p_.rolling_resistance_coefficient > 0) {
+    const Slip s = calcSlip(k);
+    // Against the spin, saturating linearly below the low-speed threshold.
+    const double dir = s.vr / std::max(std::abs(s.vr), p_.low_speed_threshold_m_s);
+    f.my_N_m = -p_.rolling_resistance_coefficient * f.fz_N * calcRollingRadius(k.deflection_m) * dir;
+  }
+  return f;
+}
+
+// --- Gim ---------------------------------------------------------------------
+// Slips (DESIGN.md section 8): braking (|Omega Re| <= |Vx|): S_s = |Vx - Omega Re| / |Vx|;
+// driving: S_s = |Vx - Omega Re| / |Omega Re|; the lateral slip |Vy| / den uses
+// the same denominator (in driving (1 - S_s) |tan alpha| = |Vy| / |Omega Re|).
+// Denominators are held >= low_speed_threshold_m_s (regularization at rest).
+void GimTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const {
+  const Slip s = calcSlip(k);
+  const double veps = p_.low_speed_threshold_m_s;
+  const bool braking = std::abs(s.vr) <= std::abs(k.vx_m_s);
+  const double den = braking ? s.den_x : std::max(std::abs(s.vr), veps);
+  const double Ss = std::min(1.0, std::abs(s.vsx) / den);
+  // Lateral slip: |tan alpha| in braking; (1 - S_s) |tan alpha| = |Vy| / |Omega Re| in driving.
+  const double Sa = braking ? std::abs(s.sigma_y) : std::abs(s.sigma_y) * s.den_x / den;
+  f.slip_ratio = -s.vsx / den;
+  f.slip_angle_rad = std::atan(s.sigma_y);
+  f.mu = calcFriction(std::hypot(Ss, Sa));
+  const double muFz = f.mu * f.fz_N;
+  const double kx = p_.longitudinal_stiffness_N * Ss;
+  const double ky = p_.cornering_stiffness_N_per_rad * Sa;
+  const double kk = std::hypot(kx, ky);
+  if (muFz <= 0 || kk <= 0) return;
+  // Adhesion fraction of the patch, l_n = 1 - |(C_s S_s, C_a S_a)| / (3 mu Fz), in [0, 1].
+  const double ln = std::min(1.0, std::max(0.0, 1.0 - kk / (3.0 * muFz)));
+  const double ln2 = ln * ln;
+  const double sliding = 1.0 - 3.0 * ln2 + 2.0 * ln2 * ln;  // sliding-region share
+  const double fxi = kx * ln2 + muFz * (kx / kk) * sliding;
+  const double feta = ky * ln2 + muFz * (ky / kk) * sliding;
+  f.fx_N = -sgn(s.vsx) * fxi;
+  f.fy_N = -sgn(s.sigma_y) * feta;
+  // Aligning moment of the adhesion region (derived; equals Fiala's in pure
+  // lateral slip): mu Fz a (1 - l_n) l_n^3 along the lateral share of the slip.
+  const double a = calcHalfContactLength(k.deflection_m);
+  f.mz_N_m = sgn(s.sigma_y) * muFz * a * (1.0 - ln) * ln2 * ln * (ky / kk);
+}
+
+// --- Fiala -------------------------------------------------------------------
+void FialaTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const {
+  const Slip s = calcSlip(k);
+  const double kappa = -s.vsx / s.den_x;  // (Omega Re - Vx) / max(|Vx|, v_eps)
+  const double tanA = s.sigma_y;
+  f.slip_ratio = kappa;
+  f.slip_angle_rad = std::atan(tanA);
+  f.mu = calcFriction(std::hypot(kappa, tanA));
+  const double muFz = f.mu * f.fz_N;
+  if (muFz <= 0) return;
+  const double Ca = p_.cornering_stiffness_N_per_rad, Cs = p_.longitudinal_stiffness_N;
+  const double H = 1.0 - Ca * std::abs(tanA) / (3.0 * muFz);
+  if (H > 0) {
+    f.fy_N = -muFz * (1.0 - H * H * H) * sgn(tanA);
+    f.mz_N_m = muFz * calcHalfContactLength(k.deflection_m) * (1.0 - H) * H * H * H * sgn(tanA);
+  } else {
+    f.fy_N = -muFz * sgn(tanA);
+  }
+  const double kappaC = muFz / (2.0 * Cs);
+  if (Cs <= 0) f.fx_N = 0;
+  else if (std::abs(kappa) < kappaC) f.fx_N = Cs * kappa;
+  else f.fx_N = sgn(kappa) * (muFz - muFz * muFz / (4.0 * std::abs(kappa) * Cs));
+}
+
+// --- Linear ------------------------------------------------------------------
+void LinearTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const {
+  const Slip s = calcSlip(k);
+  f.slip_ratio = -s.vsx / s.den_x;
+  f.slip_angle_rad = std::atan(s.sigma_y);
+  f.mu = p_.mu_max;
+  f.fx_N = p_.longitudinal_stiffness_N * f.slip_ratio;
+  f.fy_N = -p_.cornering_stiffness_N_per_rad * f.slip_angle_rad;
+}
+
+std::shared_ptr<const TireModel> makeTireModel(const std::string& type, const TireParams& p) {
+  if (type == "gim") return std::make_shared<GimTire>(p);
+  if (type == "fiala") return std::make_shared<FialaTire>(p);
+  if (type == "linear") return std::make_shared<LinearTire>(p);
+  throw Error("unknown tire model '" + type + "'; known: fiala, gim, linear");
+}
+
+}  // namespace vdyn

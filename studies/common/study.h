@@ -1,0 +1,54 @@
+#pragma once
+// Conventions every study follows (DESIGN.md section 10): options with units in
+// their names, --out DIR (default results/<study>/), summary.json, CSV with a
+// header row, PNG plots, a printed table, exit 0 on success and non-zero with a
+// one-line message on a user error or numerical failure.
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <boost/program_options.hpp>
+
+#include "vdyn/core/params.h"
+
+namespace vdyn::study {
+
+namespace po = boost::program_options;
+
+/// Runs `body`; returns 0, or prints "<study>: error: <message>" and returns 1.
+int run(const std::string& study, const std::function<void()>& body);
+
+/// Parses the command line. Adds --help and --out; on --help prints the options
+/// and exits 0. Throws Error on unknown or malformed options.
+po::variables_map parse(const std::string& study, const std::string& summary, int argc, char** argv,
+                        po::options_description& options);
+
+/// The output folder (created): --out, or <repo>/results/<study>.
+std::string outputDir(const po::variables_map& vm, const std::string& study);
+
+/// Writes JSON (pretty) to a file; throws Error if it cannot.
+void writeJson(const std::string& path, const Json& j);
+
+/// One line series of a plot, read from a CSV file by column names.
+struct Series {
+  std::string csv;
+  std::string x, y;   ///< column names
+  std::string label;
+  std::string filter = ""; ///< optional "column=value": only rows where the column equals value
+};
+
+struct PlotSpec {
+  std::string png;    ///< output file
+  std::string title, xlabel, ylabel;
+  std::vector<Series> series;
+  bool equal_axes = false;  ///< same scale on x and y (trajectories)
+};
+
+/// Renders the plots with gnuplot (pngcairo). Throws Error if gnuplot is missing
+/// or fails. The scripts are kept next to the PNGs (<png>.gp).
+void plot(const std::vector<PlotSpec>& plots);
+
+/// True when stderr is a terminal (progress output is shown only then).
+bool interactive();
+
+}  // namespace vdyn::study

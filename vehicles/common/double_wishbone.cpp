@@ -1,0 +1,156 @@
+#include "vdyn/vehicles/double_wishbone.h"
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+void RigidBodyParams::validate(const std::string& w) const {
+  requirePositive(mass_kg, w + ".mass_kg");
+  for (int i = 0; i < 3; ++i) requirePositive(inertia_kg_m2[i], w + ".inertia_kg_m2[" + std::to_string(i) + "]");
+  const Vec3& I = inertia_kg_m2;
+  if (I[0] + I[1] < I[2] || I[1] + I[2] < I[0] || I[0] + I[2] < I[1])
+    throw Error(w + ".inertia_kg_m2 violates the triangle inequality: [" + formatValue(I[0]) + ", " +
+                formatValue(I[1]) + ", " + formatValue(I[2]) + "]");
+}
+
+RigidBodyParams RigidBodyParams::fromParams(const ParamReader& r) {
+  RigidBodyParams b;
+  b.mass_kg = r.number("mass_kg");
+  b.inertia_kg_m2 = r.vec3("inertia_kg_m2");
+  b.validate(r.where());
+  return b;
+}
+
+SimTK::UnitVec3 JointParams::axis() const { return SimTK::UnitVec3(parent_axis_point_m - parent_point_m); }
+
+void JointParams::validate(const std::string& w) const {
+  for (int i = 0; i < 3; ++i) {
+    requireFinite(parent_point_m[i], w + ".parent_point_m");
+    requireFinite(child_point_m[i], w + ".child_point_m");
+  }
+  if (!revolute) return;
+  const Vec3 ap = parent_axis_point_m - parent_point_m, ac = child_axis_point_m - child_point_m;
+  if (!(ap.norm() > 1e-9)) throw Error(w + ": parent_axis_point_m coincides with parent_point_m");
+  if (!(ac.norm() > 1e-9)) throw Error(w + ": child_axis_point_m coincides with child_point_m");
+  if ((ap.normalize() - ac.normalize()).norm() > 1e-9)
+    throw Error(w + ": the axis on the parent and on the child point in different directions");
+}
+
+JointParams JointParams::fromParams(const ParamReader& r, bool revolute) {
+  JointParams j;
+  j.revolute = revolute;
+  j.parent_point_m = r.vec3("parent_point_m");
+  j.child_point_m = r.vec3("child_point_m");
+  if (revolute) {
+    j.parent_axis_point_m = r.vec3("parent_axis_point_m");
+    j.child_axis_point_m = r.vec3("child_axis_point_m");
+  }
+  j.validate(r.where());
+  return j;
+}
+
+void DoubleWishboneParams::validate(const std::string& w) const {
+  lower_arm.validate(w + ".lower_arm");
+  knuckle.validate(w + ".knuckle");
+  upper_arm.validate(w + ".upper_arm");
+  wheel.validate(w + ".wheel");
+  lower_pivot.validate(w + ".lower_pivot");
+  lower_ball.validate(w + ".lower_ball");
+  upper_ball.validate(w + ".upper_ball");
+  upper_pivot.validate(w + ".upper_pivot");
+  if (!(wheel_spin_axis.norm() > 0.5)) throw Error(w + ".wheel_spin_axis must be a unit vector");
+  requireNonNegative(spring_stiffness_N_per_m, w + ".spring.stiffness_N_per_m");
+  requireNonNegative(damper_N_s_per_m, w + ".spring.damping_N_s_per_m");
+  requirePositive(spring_free_length_m, w + ".spring.free_length_m");
+}
+
+DoubleWishboneParams DoubleWishboneParams::fromParams(const ParamReader& r) {
+  DoubleWishboneParams p;
+  const ParamReader b = r.child("bodies");
+  p.lower_arm = RigidBodyParams::fromParams(b.child("lower_arm"));
+  p.knuckle = RigidBodyParams::fromParams(b.child("knuckle"));
+  p.upper_arm = RigidBodyParams::fromParams(b.child("upper_arm"));
+  p.wheel = RigidBodyParams::fromParams(b.child("wheel"));
+  const ParamReader j = r.child("joints");
+  p.lower_pivot = JointParams::fromParams(j.child("lower_pivot"), true);
+  p.lower_ball = JointParams::fromParams(j.child("lower_ball"), false);
+  p.upper_ball = JointParams::fromParams(j.child("upper_ball"), false);
+  p.upper_pivot = JointParams::fromParams(j.child("upper_pivot"), true);
+  p.wheel_spin_axis = j.vec3Or("wheel_spin_axis", p.wheel_spin_axis);
+  const ParamReader s = r.child("spring");
+  p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
+  p.damper_N_s_per_m = s.number("damping_N_s_per_m");
+  p.spring_free_length_m = s.number("free_length_m");
+  p.spring_chassis_point_m = s.vec3("chassis_point_m");
+  p.spring_arm_point_m = s.vec3Or("arm_point_m", Vec3(0));
+  p.validate(r.where());
+  return p;
+}
+
+DoubleWishboneParams DoubleWishboneParams::mirrored() const {
+  auto point = [](const Vec3& v) { return Vec3(v[0], -v[1], v[2]); };
+  auto axial = [](const Vec3& v) { return Vec3(-v[0], v[1], -v[2]); };  // -M v for M = diag(1,-1,1)
+  auto joint = [&](JointParams j) {
+    const Vec3 ap = j.parent_axis_point_m - j.parent_point_m, ac = j.child_axis_point_m - j.child_point_m;
+    j.parent_point_m = point(j.parent_point_m);
+    j.child_point_m = point(j.child_point_m);
+    if (j.revolute) {
+      j.parent_axis_point_m = j.parent_point_m + axial(ap);
+      j.child_axis_point_m = j.child_point_m + axial(ac);
+    }
+    return j;
+  };
+  DoubleWishboneParams m = *this;
+  m.lower_pivot = joint(lower_pivot);
+  m.lower_ball = joint(lower_ball);
+  m.upper_ball = joint(upper_ball);
+  m.upper_pivot = joint(upper_pivot);
+  m.wheel_spin_axis = axial(wheel_spin_axis);
+  m.spring_chassis_point_m = point(spring_chassis_point_m);
+  m.spring_arm_point_m = point(spring_arm_point_m);
+  return m;
+}
+
+Vec3 wheelCentreInChassis(const DoubleWishboneParams& p) {
+  const Vec3 lowerArm = p.lower_pivot.parent_point_m - p.lower_pivot.child_point_m;
+  return lowerArm + p.lower_ball.parent_point_m - p.lower_ball.child_point_m;
+}
+
+static SimTK::Body::Rigid rigidBody(const RigidBodyParams& b) {
+  return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
+}
+
+/// Frame at `point` whose z axis is `axis` (Simbody's Pin turns about z).
+static SimTK::Transform pinFrame(const Vec3& point, const SimTK::UnitVec3& axis) {
+  return SimTK::Transform(SimTK::Rotation(axis, SimTK::ZAxis), point);
+}
+
+DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& chassis,
+                                         const DoubleWishboneParams& p, const std::string& prefix) {
+  p.validate(prefix + "corner");
+  DoubleWishboneCorner c;
+  const SimTK::UnitVec3 a1 = p.lower_pivot.axis(), a4 = p.upper_pivot.axis();
+  c.lower_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.lower_pivot.parent_point_m, a1),
+                                          rigidBody(p.lower_arm), pinFrame(p.lower_pivot.child_point_m, a1));
+  c.knuckle = SimTK::MobilizedBody::Ball(c.lower_arm, SimTK::Transform(p.lower_ball.parent_point_m),
+                                         rigidBody(p.knuckle), SimTK::Transform(p.lower_ball.child_point_m));
+  c.upper_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.upper_pivot.parent_point_m, a4),
+                                          rigidBody(p.upper_arm), pinFrame(p.upper_pivot.child_point_m, a4));
+  const SimTK::UnitVec3 spin(p.wheel_spin_axis);
+  c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), rigidBody(p.wheel),
+                                      pinFrame(Vec3(0), spin));
+  c.upper_ball = SimTK::Constraint::Ball(c.upper_arm, p.upper_ball.parent_point_m, c.knuckle,
+                                         p.upper_ball.child_point_m);
+  c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
+                                                p.spring_arm_point_m, p.spring_stiffness_N_per_m,
+                                                p.spring_free_length_m);
+  c.damper = SimTK::Force::TwoPointLinearDamper(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
+                                                p.spring_arm_point_m, p.damper_N_s_per_m);
+  scene.addBody(prefix + "lower_arm", c.lower_arm);
+  scene.addBody(prefix + "knuckle", c.knuckle);
+  scene.addBody(prefix + "upper_arm", c.upper_arm);
+  scene.addBody(prefix + "wheel", c.wheel);
+  return c;
+}
+
+}  // namespace vdyn

@@ -1,0 +1,81 @@
+#pragma once
+// The seed's double-wishbone (double A-arm) corner, Appendix A: lower A-arm on a
+// revolute joint to the chassis (joint 1), knuckle on a spherical joint to the
+// lower arm (joint 2), upper A-arm on a revolute joint to the chassis (joint 4),
+// the loop cut at the upper spherical joint (joint 3) and closed by a
+// Constraint::Ball, the wheel on a revolute (spin) joint to the knuckle (joint
+// 17), and the suspension spring-damper from the chassis to the lower arm.
+// Body-fixed points are in each body's frame (origin at its centre of mass,
+// axes parallel to the chassis frame xi forward, eta left, zeta up, in the
+// tabulated configuration). The joint points are the truth for the mechanism.
+#include <string>
+
+#include <Simbody.h>
+
+#include "vdyn/core/params.h"
+#include "vdyn/core/scene.h"
+
+namespace vdyn {
+
+struct RigidBodyParams {
+  double mass_kg = 1;
+  SimTK::Vec3 inertia_kg_m2{1, 1, 1};  ///< principal moments about the c.m., body axes
+  void validate(const std::string& where) const;
+  static RigidBodyParams fromParams(const ParamReader& r);
+};
+
+/// A joint between a parent and a child body: a point on each (body frames, m).
+/// For revolute joints a second point on each gives the axis direction.
+struct JointParams {
+  SimTK::Vec3 parent_point_m, child_point_m;
+  SimTK::Vec3 parent_axis_point_m, child_axis_point_m;  ///< revolute joints only
+  bool revolute = false;
+  /// Unit axis direction (parent frame) from parent_point to parent_axis_point.
+  SimTK::UnitVec3 axis() const;
+  void validate(const std::string& where) const;
+  static JointParams fromParams(const ParamReader& r, bool revolute);
+};
+
+struct DoubleWishboneParams {
+  RigidBodyParams lower_arm, knuckle, upper_arm, wheel;
+  JointParams lower_pivot;  ///< joint 1: chassis - lower arm, revolute
+  JointParams lower_ball;   ///< joint 2: lower arm - knuckle, spherical
+  JointParams upper_ball;   ///< joint 3: upper arm - knuckle, spherical (cut, a constraint)
+  JointParams upper_pivot;  ///< joint 4: chassis - upper arm, revolute
+  SimTK::Vec3 wheel_spin_axis{0, 1, 0};  ///< joint 17: spin axis in knuckle and wheel frames
+  double spring_stiffness_N_per_m = 9.16e4;
+  double damper_N_s_per_m = 1.44e4;
+  double spring_free_length_m = 0.344;
+  SimTK::Vec3 spring_chassis_point_m{1.31, -0.395, -0.10};
+  SimTK::Vec3 spring_arm_point_m{0, 0, 0};  ///< on the lower arm
+
+  void validate(const std::string& where) const;
+  static DoubleWishboneParams fromParams(const ParamReader& r);
+  /// The left-side corner from a right-side one: points mirrored eta -> -eta,
+  /// axes as axial vectors (so the spin axis stays +eta and forward rolling
+  /// stays a positive spin on both sides).
+  DoubleWishboneParams mirrored() const;
+};
+
+/// Handles of a corner built into a scene.
+struct DoubleWishboneCorner {
+  SimTK::MobilizedBody::Pin lower_arm;
+  SimTK::MobilizedBody::Ball knuckle;
+  SimTK::MobilizedBody::Pin upper_arm;
+  SimTK::MobilizedBody::Pin wheel;
+  SimTK::Constraint::Ball upper_ball;
+  SimTK::Force::TwoPointLinearSpring spring;
+  SimTK::Force::TwoPointLinearDamper damper;
+};
+
+/// Adds the corner's bodies, joints, loop constraint and spring-damper to the
+/// scene under `chassis`; bodies are registered as <prefix>lower_arm,
+/// <prefix>knuckle, <prefix>upper_arm, <prefix>wheel.
+DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& chassis,
+                                         const DoubleWishboneParams& p, const std::string& prefix);
+
+/// Position of the knuckle (and wheel) origin in the chassis frame in the
+/// tabulated configuration, following the tree joints from the chassis.
+SimTK::Vec3 wheelCentreInChassis(const DoubleWishboneParams& p);
+
+}  // namespace vdyn

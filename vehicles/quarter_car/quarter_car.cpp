@@ -1,0 +1,191 @@
+#include "vdyn/vehicles/quarter_car.h"
+
+#include "vdyn/core/equilibrium.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/plugins/builtin.h"
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+void QuarterCarParams::validate() const {
+  requirePositive(chassis_mass_kg, "quarter car chassis_mass_kg");
+  corner.validate("quarter car corner");
+  tire.validate("quarter car tire");
+  makeRoad(road);
+  requireFinite(upper_pivot_offset_m, "quarter car upper_pivot_offset_m");
+  requireNonNegative(gravity_m_per_s2, "quarter car gravity_m_per_s2");
+  if (tire_plugin.empty()) throw Error("quarter car tire plugin name is empty");
+}
+
+/// Applies the keys of `patch` on top of `base` (objects merged recursively).
+static Json merged(Json base, const Json& patch) {
+  base.merge_patch(patch);
+  return base;
+}
+
+QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r) {
+  QuarterCarParams p;
+  const ParamReader vehicle = ParamReader::fromFile(r.string("vehicle_data"));
+  const std::string cornerName = r.stringOr("corner", "front_right");
+  // The quarter car's own values are patched onto the vehicle data, so each
+  // value lives in one data file: the corner and tire from App. A, the
+  // chapter 4 values (m3, K, D, Cz, ...) in the quarter-car file.
+  Json corner = vehicle.child(cornerName).json();
+  if (r.has("corner_overrides")) corner = merged(corner, r.child("corner_overrides").json());
+  p.corner = DoubleWishboneParams::fromParams(ParamReader::fromJson(corner, r.where() + " " + cornerName));
+  const ParamReader tire = vehicle.child("tire");
+  p.tire_plugin = tire.string("plugin");
+  Json tireParams = tire.child("params").json();
+  if (r.has("tire")) {
+    const ParamReader t = r.child("tire");
+    p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
+    if (t.has("params")) tireParams = merged(tireParams, t.child("params").json());
+  }
+  p.tire = TireParams::fromParams(ParamReader::fromJson(tireParams, r.where() + " tire.params"));
+  p.chassis_mass_kg = r.number("chassis_mass_kg");
+  p.road = RoadParams::fromParams(r.child("road"));
+  p.upper_pivot_offset_m = r.numberOr("upper_pivot_offset_m", 0.0);
+  p.steer_lock = r.booleanOr("steer_lock", true);
+  p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", 9.81);
+  p.spring_free_length_from_ride_height = r.booleanOr("spring_free_length_from_ride_height", false);
+  requirePositive(p.chassis_mass_kg, r.at("chassis_mass_kg"));
+  p.validate();
+  return p.spring_free_length_from_ride_height ? p.withRideHeightSpring() : p;
+}
+
+QuarterCarParams QuarterCarParams::withRideHeightSpring() const {
+  QuarterCarParams p = *this;
+  p.spring_free_length_from_ride_height = false;
+  const QuarterCar car(p);
+  SimTK::State s = car.makeInitialState(false);
+  const auto arm = car.corner().lower_arm;
+  // Equilibrium of everything but the lower arm, held at its tabulated angle;
+  // the chassis height does not depend on the spring (the tire carries the weight).
+  const StaticEquilibriumResult eq = solveStaticEquilibrium(
+      car.getScene(), s, {car.corner().wheel.getMobilizedBodyIndex(), arm.getMobilizedBodyIndex()});
+  const double imbalance = eq.force_residual_all[arm.getFirstUIndex(s)];
+  // The spring's generalized force on the arm angle is -K (l - l0) dl/dq, so the
+  // residual is linear in l0: one step makes it vanish.
+  auto length = [&](double q) {
+    SimTK::State t = s;
+    arm.setOneQ(t, 0, q);
+    car.getScene().getSystem().realize(t, SimTK::Stage::Position);
+    return (car.chassis().findStationLocationInGround(t, p.corner.spring_chassis_point_m) -
+            arm.findStationLocationInGround(t, p.corner.spring_arm_point_m)).norm();
+  };
+  const double q = arm.getOneQ(s, 0), h = 1e-6;
+  const double dl_dq = (length(q + h) - length(q - h)) / (2 * h);
+  p.corner.spring_free_length_m += imbalance / (p.corner.spring_stiffness_N_per_m * dl_dq);
+  requirePositive(p.corner.spring_free_length_m, "quarter car spring free length for the ride height");
+  return p;
+}
+
+QuarterCarParams QuarterCarParams::fromFile(const std::string& path) {
+  return fromParams(ParamReader::fromFile(path));
+}
+
+QuarterCar::QuarterCar(const QuarterCarParams& params) : QuarterCar(params, builtinPlugins()) {}
+
+QuarterCar::QuarterCar(const QuarterCarParams& params, const PluginRegistry& registry)
+    : p_(params), scene_(std::make_unique<Scene>()) {
+  p_.validate();
+  Scene& sc = *scene_;
+  SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
+
+  // Chassis on a vertical slider (Simbody's Slider moves along x of its frames).
+  const SimTK::Rotation R_GF(SimTK::UnitVec3(SimTK::ZAxis), SimTK::XAxis);
+  SimTK::Body::Rigid chassisBody(SimTK::MassProperties(p_.chassis_mass_kg, Vec3(0), SimTK::Inertia(1, 1, 1)));
+  chassis_ = SimTK::MobilizedBody::Slider(sc.updMatter().Ground(), SimTK::Transform(R_GF, Vec3(0)), chassisBody,
+                                          SimTK::Transform(R_GF, Vec3(0)));
+  sc.addBody("chassis", chassis_);
+
+  DoubleWishboneParams cp = p_.corner;
+  cp.upper_pivot.child_point_m[2] += p_.upper_pivot_offset_m;  // s' moves the pivot and its axis point together
+  cp.upper_pivot.child_axis_point_m[2] += p_.upper_pivot_offset_m;
+  corner_ = buildDoubleWishbone(sc, chassis_, cp, "");
+  if (p_.steer_lock)
+    SimTK::Constraint::ConstantAngle(chassis_, SimTK::UnitVec3(SimTK::XAxis), corner_.knuckle,
+                                     SimTK::UnitVec3(cp.wheel_spin_axis));
+
+  auto road = makeRoad(p_.road);
+  sc.setService<const Road>("road", road);
+  const PluginSpec spec{"tire", ParamReader::fromJson(Json{{"params", p_.tire.toJson()}}, "quarter car tire"),
+                        {{"wheel", "wheel"}}};
+  tire_ = dynamic_cast<const TirePlugin*>(
+      &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire_plugin, spec, "quarter car tire plugin")));
+  if (!tire_) throw Error("quarter car tire plugin '" + p_.tire_plugin + "' is not a tire plugin");
+
+  const auto c = chassis_;
+  const auto w = corner_.wheel;
+  const auto arm = corner_.lower_arm;
+  const Vec3 sc_C = cp.spring_chassis_point_m, sa_A = cp.spring_arm_point_m;
+  using SimTK::Stage;
+  sc.addOutput({"chassis.z_m", "m", Stage::Position, [c](const SimTK::State& s) { return c.getOneQ(s, 0); }});
+  sc.addOutput({"chassis.vz_m_s", "m/s", Stage::Velocity, [c](const SimTK::State& s) { return c.getOneU(s, 0); }});
+  sc.addOutput({"chassis.az_m_s2", "m/s^2", Stage::Acceleration,
+                [c](const SimTK::State& s) { return c.getOneUDot(s, 0); }});
+  sc.addOutput({"wheel.spin_rad_s", "rad/s", Stage::Velocity, [w](const SimTK::State& s) { return w.getOneU(s, 0); }});
+  sc.addOutput({"road.height_m", "m", Stage::Time,
+                [road](const SimTK::State& s) { return road->height(0, 0, s.getTime()); }});
+  sc.addOutput({"suspension.length_m", "m", Stage::Position, [c, arm, sc_C, sa_A](const SimTK::State& s) {
+                  return (c.findStationLocationInGround(s, sc_C) - arm.findStationLocationInGround(s, sa_A)).norm();
+                }});
+}
+
+double QuarterCar::totalMass() const {
+  return p_.chassis_mass_kg + p_.corner.lower_arm.mass_kg + p_.corner.knuckle.mass_kg +
+         p_.corner.upper_arm.mass_kg + p_.corner.wheel.mass_kg;
+}
+
+int QuarterCar::degreesOfFreedom(const SimTK::State& s) const {
+  scene_->getSystem().realize(s, SimTK::Stage::Instance);
+  return s.getNU() - s.getNUDotErr();
+}
+
+std::vector<SimTK::MobilizedBodyIndex> QuarterCar::ineffectiveMobilizers() const {
+  return {corner_.wheel.getMobilizedBodyIndex()};  // the spin angle does not matter at rest
+}
+
+SimTK::State QuarterCar::makeInitialState(bool equilibrium, AssemblyReport* report) const {
+  const SimTK::MultibodySystem& system = scene_->getSystem();
+  SimTK::State s = scene_->getDefaultState();
+  // Chassis height so that the tire carries roughly the weight in the tabulated configuration.
+  const Vec3 wc = wheelCentreInChassis(p_.corner);
+  const double road0 = makeRoad(p_.road)->height(0, 0, 0);
+  const double sag = totalMass() * p_.gravity_m_per_s2 / p_.tire.radial_stiffness_N_per_m;
+  chassis_.setOneQ(s, 0, road0 + p_.tire.unloaded_radius_m - wc[2] - sag);
+  system.realize(s, SimTK::Stage::Position);
+
+  const std::vector<std::pair<std::string, SimTK::MobilizedBody>> bodies = {
+      {"lower_arm", corner_.lower_arm}, {"knuckle", corner_.knuckle}, {"upper_arm", corner_.upper_arm},
+      {"wheel", corner_.wheel}};
+  std::vector<Vec3> before;
+  for (const auto& b : bodies) before.push_back(b.second.getBodyOriginLocation(s));
+  const double gap = positionConstraintError(s);
+
+  SimTK::Assembler assembler(system);
+  assembler.lockMobilizer(chassis_.getMobilizedBodyIndex());
+  assembler.lockMobilizer(corner_.wheel.getMobilizedBodyIndex());
+  assembler.setErrorTolerance(1e-10);
+  try {
+    assembler.assemble(s);
+  } catch (const std::exception& e) {
+    throw Error(std::string("quarter car: closing the suspension loop failed: ") + e.what());
+  }
+  system.realize(s, SimTK::Stage::Position);
+  if (report) {
+    report->initial_loop_gap_m = gap;
+    report->body_moves_m.clear();
+    report->max_move_m = 0;
+    for (std::size_t i = 0; i < bodies.size(); ++i) {
+      const double d = (bodies[i].second.getBodyOriginLocation(s) - before[i]).norm();
+      report->body_moves_m.emplace_back(bodies[i].first, d);
+      report->max_move_m = std::max(report->max_move_m, d);
+    }
+  }
+  if (equilibrium) solveStaticEquilibrium(*scene_, s, ineffectiveMobilizers());
+  return s;
+}
+
+}  // namespace vdyn
