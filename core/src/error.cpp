@@ -5,14 +5,12 @@
 namespace vdyn {
 
 std::string formatValue(double v) {
+  // Plain notation where 15 significant digits round-trip (-200, 0.02, 1e-05);
+  // 17 digits otherwise.
   char buf[64];
+  std::snprintf(buf, sizeof buf, "%.15g", v);
+  if (std::isnan(v) || std::strtod(buf, nullptr) == v) return buf;
   std::snprintf(buf, sizeof buf, "%.17g", v);
-  // Prefer the shortest representation that round-trips.
-  for (int prec = 1; prec <= 17; ++prec) {
-    char b[64];
-    std::snprintf(b, sizeof b, "%.*g", prec, v);
-    if (std::strtod(b, nullptr) == v || std::isnan(v)) return b;
-  }
   return buf;
 }
 

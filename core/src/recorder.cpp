@@ -16,11 +16,18 @@ Recorder::Recorder(const Scene& scene, std::vector<std::string> names)
 
 void Recorder::record(const SimTK::State& state) {
   const SimTK::State* s = &state;
-  SimTK::State copy;
   if (state.getSystemStage() < stage_) {
-    copy = state;
-    scene_.getSystem().realize(copy, stage_);
-    s = &copy;
+    if (!haveWork_) {
+      work_ = state;
+      haveWork_ = true;
+    } else {
+      work_.setTime(state.getTime());
+      work_.updQ() = state.getQ();
+      work_.updU() = state.getU();
+      work_.updZ() = state.getZ();
+    }
+    scene_.getSystem().realize(work_, stage_);
+    s = &work_;
   }
   time_.push_back(s->getTime());
   for (std::size_t i = 0; i < outputs_.size(); ++i) columns_[i].push_back(outputs_[i]->eval(*s));

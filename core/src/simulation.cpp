@@ -54,6 +54,10 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   if (reporting) recorder->record(integ->getState());
   double lastReported = t0;
 
+  // Simbody 3.7's CPodes can step past the final time and then never report
+  // EndOfSimulation (simbody issue #824, fixed after 3.7), so the loop also ends
+  // when the integrator's time reaches t_end.
+  const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
   for (;;) {
     SimTK::Integrator::SuccessfulStepStatus status;
     try {
@@ -73,12 +77,14 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         lastReported = integ->getTime();
         ++k;
       }
-    } else if (status == S::EndOfSimulation) {
-      if (reporting && integ->getTime() > lastReported + 1e-12) recorder->record(integ->getState());
+    }
+    if (status == S::EndOfSimulation || integ->getTime() >= s.t_end_s - tEndTol) {
+      if (reporting && integ->getTime() > lastReported + tEndTol) recorder->record(integ->getState());
       break;
     }
   }
-  if (integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
+  if (integ->isSimulationOver() &&
+      integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
     throw Error("simulate: " + s.integrator.method + " stopped early at t = " +
                 formatValue(integ->getTime()) + " s (" +
                 SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");

@@ -77,6 +77,8 @@ void plot(const std::vector<PlotSpec>& plots) {
       << "set xlabel " << quote(p.xlabel) << " noenhanced\nset ylabel " << quote(p.ylabel) << " noenhanced\n"
       << "set key noenhanced\n";
     if (p.equal_axes) g << "set size ratio -1\n";
+    if (p.logx) g << "set logscale x\nset format x '10^{%L}'\n";
+    if (p.logy) g << "set logscale y\nset format y '10^{%L}'\n";
         g << "plot ";
     for (std::size_t i = 0; i < p.series.size(); ++i) {
       const Series& s = p.series[i];
@@ -87,7 +89,7 @@ void plot(const std::vector<PlotSpec>& plots) {
             " : NaN)";
       }
       g << (i ? ", \\\n     " : "") << quote(s.csv) << " using (column(" << quote(s.x) << ")):(" << y << ")"
-        << " with lines lw 2 title " << quote(s.label);
+        << (p.points ? " with linespoints lw 2 pt 7 title " : " with lines lw 2 title ") << quote(s.label);
     }
     g << "\n";
     g.close();

@@ -42,6 +42,8 @@ struct PlotSpec {
   std::string title, xlabel, ylabel;
   std::vector<Series> series;
   bool equal_axes = false;  ///< same scale on x and y (trajectories)
+  bool logx = false, logy = false;
+  bool points = false;      ///< lines with point markers
 };
 
 /// Renders the plots with gnuplot (pngcairo). Throws Error if gnuplot is missing

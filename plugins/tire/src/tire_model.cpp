@@ -7,6 +7,11 @@ namespace vdyn {
 
 namespace {
 double sgn(double v) { return v > 0 ? 1.0 : (v < 0 ? -1.0 : 0.0); }
+/// Which edge of the patch leads: +1 forward, -1 in reverse, a linear ramp
+/// below the low-speed threshold so the aligning moment stays continuous.
+double travelDirection(const ContactKinematics& k, double veps) {
+  return k.vx_m_s / std::max(std::abs(k.vx_m_s), veps);
+}
 }  // namespace
 
 void TireParams::validate(const std::string& w) const {
@@ -150,8 +155,9 @@ void GimTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const 
   f.fy_N = -sgn(s.sigma_y) * feta;
   // Aligning moment of the adhesion region (derived; equals Fiala's in pure
   // lateral slip): mu Fz a (1 - l_n) l_n^3 along the lateral share of the slip.
+  // The trail lies behind the patch centre in the direction of travel.
   const double a = calcHalfContactLength(k.deflection_m);
-  f.mz_N_m = sgn(s.sigma_y) * muFz * a * (1.0 - ln) * ln2 * ln * (ky / kk);
+  f.mz_N_m = travelDirection(k, p_.low_speed_threshold_m_s) * sgn(s.sigma_y) * muFz * a * (1.0 - ln) * ln2 * ln * (ky / kk);
 }
 
 // --- Fiala -------------------------------------------------------------------
@@ -168,7 +174,7 @@ void FialaTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) cons
   const double H = 1.0 - Ca * std::abs(tanA) / (3.0 * muFz);
   if (H > 0) {
     f.fy_N = -muFz * (1.0 - H * H * H) * sgn(tanA);
-    f.mz_N_m = muFz * calcHalfContactLength(k.deflection_m) * (1.0 - H) * H * H * H * sgn(tanA);
+    f.mz_N_m = travelDirection(k, p_.low_speed_threshold_m_s) * muFz * calcHalfContactLength(k.deflection_m) * (1.0 - H) * H * H * H * sgn(tanA);
   } else {
     f.fy_N = -muFz * sgn(tanA);
   }

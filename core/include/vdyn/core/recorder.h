@@ -13,8 +13,10 @@ class Recorder {
   /// Records time plus the named outputs (each must exist in the scene).
   Recorder(const Scene& scene, std::vector<std::string> outputNames);
 
-  /// Evaluates the outputs on `state`; realizes a copy if `state` is not yet
-  /// realized far enough (the integrator's state is const).
+  /// Evaluates the outputs on `state`. If `state` is not realized far enough (the
+  /// integrator's state is const), its t, q, u, z are copied into a workspace
+  /// state that is realized instead (a full State copy would also copy and
+  /// reallocate every cache entry).
   void record(const SimTK::State& state);
 
   const std::vector<std::string>& names() const { return names_; }
@@ -31,6 +33,8 @@ class Recorder {
   std::vector<std::string> names_;
   std::vector<const Output*> outputs_;
   SimTK::Stage stage_ = SimTK::Stage::Time;
+  SimTK::State work_;
+  bool haveWork_ = false;
   std::vector<double> time_;
   std::vector<std::vector<double>> columns_;
 };

@@ -39,29 +39,34 @@ class FlatRoad : public Road {
   double h_;
 };
 
-/// A flat road moving vertically: h(t) = base + A sin(2 pi f t + phase) (seed 4.45).
+/// A flat road moving vertically (seed 4.45): at rest at its base height up to
+/// start_time_s, then h(t) = base + A sin(2 pi f (t - start) + phase). A model
+/// at rest on it at t <= start is in static equilibrium; the motion starts after.
 class SineRoad : public Road {
  public:
   /// amplitude_m >= 0, frequency_Hz >= 0.
-  SineRoad(double amplitude_m, double frequency_Hz, double phase_rad = 0.0, double base_height_m = 0.0);
+  SineRoad(double amplitude_m, double frequency_Hz, double phase_rad = 0.0, double base_height_m = 0.0,
+           double start_time_s = 0.0);
 
  protected:
   double DoHeight(double, double, double t) const override;
   double DoHeightRate(double, double, double t) const override;
 
  private:
-  double a_, w_, phase_, base_;
+  double a_, w_, phase_, base_, start_;
 };
 
 /// Road description filled by C++ or by a data-file object:
 /// {"type": "flat", "height_m": 0} or
-/// {"type": "sine", "amplitude_m": 0.02, "frequency_Hz": 3, "phase_rad": 0, "height_m": 0}.
+/// {"type": "sine", "amplitude_m": 0.02, "frequency_Hz": 3, "phase_rad": 0, "height_m": 0,
+///  "start_time_s": 0}.
 struct RoadParams {
   std::string type = "flat";  ///< "flat" or "sine"
   double height_m = 0;        ///< base height of the surface, m
   double amplitude_m = 0;     ///< sine: amplitude A of the vertical motion, m
   double frequency_Hz = 0;    ///< sine: frequency f, Hz
   double phase_rad = 0;       ///< sine: phase, rad
+  double start_time_s = 0;    ///< sine: the road is at rest up to this time, s
   static RoadParams fromParams(const ParamReader& r);
 };
 

@@ -1,0 +1,187 @@
+// Core: data-file errors, registry, integrator choice, recorder, scene costs.
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "vdyn/core/simulation.h"
+#include "vdyn/plugins/builtin.h"
+#include "vdyn/vehicles/quarter_car.h"
+
+using namespace vdyn;
+
+namespace {
+
+/// The quarter-car data file as JSON, to corrupt one key at a time.
+Json quarterCarJson() { return readJsonFile(resolveDataPath("quarter_car.json")); }
+
+std::string errorOf(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const Error& e) {
+    return e.what();
+  }
+  return "(no error)";
+}
+
+QuarterCarParams parse(const Json& j) { return QuarterCarParams::fromParams(ParamReader::fromJson(j, "qc.json")); }
+
+}  // namespace
+
+TEST(DataFile, MissingKeyIsNamed) {
+  Json j = quarterCarJson();
+  j.erase("chassis_mass_kg");
+  EXPECT_EQ(errorOf([&] { parse(j); }), "qc.json: chassis_mass_kg: missing key");
+}
+
+TEST(DataFile, NegativeMassIsNamedWithItsValue) {
+  Json j = quarterCarJson();
+  j["chassis_mass_kg"] = -200.0;
+  EXPECT_EQ(errorOf([&] { parse(j); }), "qc.json: chassis_mass_kg must be positive, got -200");
+}
+
+TEST(DataFile, NegativeBodyMassInCornerOverrideIsNamed) {
+  Json j = quarterCarJson();
+  j["corner_overrides"]["bodies"]["knuckle"]["mass_kg"] = -5.0;
+  const std::string msg = errorOf([&] { parse(j); });
+  EXPECT_NE(msg.find("knuckle.mass_kg must be positive, got -5"), std::string::npos) << msg;
+}
+
+TEST(DataFile, WrongTypeIsNamed) {
+  Json j = quarterCarJson();
+  j["road"]["amplitude_m"] = "0.02";
+  EXPECT_EQ(errorOf([&] { parse(j); }), "qc.json: road.amplitude_m: expected a number, got string \"0.02\"");
+}
+
+TEST(DataFile, NaNFromCodeIsNamed) {
+  // JSON cannot hold NaN, but the C++ builders fill the same struct and the
+  // same validate() runs on it.
+  QuarterCarParams p = parse(quarterCarJson());
+  p.chassis_mass_kg = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(errorOf([&] { QuarterCar car(p); }), "quarter car chassis_mass_kg must be a finite number, got nan");
+  p = parse(quarterCarJson());
+  p.tire.cornering_stiffness_N_per_rad = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(errorOf([&] { QuarterCar car(p); }),
+            "quarter car tire.cornering_stiffness_N_per_rad must be a finite number, got nan");
+}
+
+TEST(DataFile, UnknownTirePluginListsKnownOnes) {
+  Json j = quarterCarJson();
+  j["tire"]["plugin"] = "pacejka";
+  // The ride-height spring is computed while parsing, so parsing builds the car.
+  EXPECT_EQ(errorOf([&] { parse(j); }),
+            "quarter car tire plugin: unknown force element plugin 'pacejka'; known: fiala, gim, linear");
+}
+
+TEST(DataFile, UnknownRoadTypeListsKnownOnes) {
+  Json j = quarterCarJson();
+  j["road"]["type"] = "cobbles";
+  EXPECT_EQ(errorOf([&] { parse(j); }), "qc.json: road.type: unknown road type 'cobbles'; known: flat, sine");
+}
+
+TEST(DataFile, MissingFileAndBadSyntaxAreNamed) {
+  EXPECT_NE(errorOf([] { ParamReader::fromFile("no_such_vehicle.json"); }).find("'no_such_vehicle.json' not found"),
+            std::string::npos);
+  const std::string bad = ::testing::TempDir() + "/bad.json";
+  { std::ofstream(bad) << "{ \"a\": 1, }"; }
+  EXPECT_NE(errorOf([&] { ParamReader::fromFile(bad); }).find("is not valid JSON"), std::string::npos);
+}
+
+TEST(Registry, DuplicateAndUnknownNames) {
+  PluginRegistry r;
+  registerTirePlugins(r);
+  EXPECT_EQ(r.known(PluginKind::ForceElement), (std::vector<std::string>{"fiala", "gim", "linear"}));
+  EXPECT_TRUE(r.known(PluginKind::Controller).empty());
+  EXPECT_EQ(errorOf([&] { registerTirePlugins(r); }), "force element plugin 'gim' is already registered");
+  const PluginSpec spec{"x", ParamReader::fromJson(Json::object(), "spec")};
+  EXPECT_EQ(errorOf([&] { r.create(PluginKind::Controller, "pid", spec, "scene.json: controller"); }),
+            "scene.json: controller: unknown controller plugin 'pid'; known: (none)");
+}
+
+TEST(Integrators, UnknownNameAndBadAccuracy) {
+  IntegratorSettings s;
+  s.method = "euler";
+  EXPECT_EQ(errorOf([&] { s.validate(); }),
+            "unknown integrator 'euler'; known: rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2");
+  s.method = "rk3";
+  s.accuracy = 2;
+  EXPECT_EQ(errorOf([&] { s.validate(); }), "integrator accuracy must lie in (0, 1), got 2");
+}
+
+TEST(Integrators, AllSixAreConstructedWithTheirSettings) {
+  const QuarterCar car(parse(quarterCarJson()));
+  for (const auto& name : integratorNames()) {
+    IntegratorSettings s;
+    s.method = name;
+    s.accuracy = 1e-5;
+    auto integ = makeIntegrator(car.getScene().getSystem(), s);
+    integ->initialize(car.makeInitialState(false));
+    EXPECT_EQ(integ->getAccuracyInUse(), 1e-5) << name;
+    EXPECT_EQ(integ->getConstraintToleranceInUse(), 1e-10) << name;
+  }
+}
+
+TEST(Scene, PaysOnlyForRequestedCosts) {
+  // A scene that asks for no cost integral carries no extra state variable.
+  QuarterCar plain(parse(quarterCarJson()));
+  EXPECT_EQ(plain.getScene().getDefaultState().getNZ(), 0);
+  QuarterCar withCost(parse(quarterCarJson()));
+  withCost.updScene().addIntegralOfSquare("chassis.az_m_s2");
+  EXPECT_EQ(withCost.getScene().getDefaultState().getNZ(), 1);
+}
+
+TEST(Scene, UnknownBodyAndOutputListKnownOnes) {
+  const QuarterCar car(parse(quarterCarJson()));
+  EXPECT_EQ(errorOf([&] { car.getScene().getBody("frame"); }),
+            "scene has no body named 'frame'; known: chassis, knuckle, lower_arm, upper_arm, wheel");
+  const std::string msg = errorOf([&] { car.getScene().getOutput("chassis.x_m"); });
+  EXPECT_NE(msg.find("scene has no output named 'chassis.x_m'; known: chassis.az_m_s2"), std::string::npos) << msg;
+}
+
+TEST(Recorder, SamplingDoesNotForceIntegratorSteps) {
+  // Report samples are interpolated: the integrator's step sequence, and so its
+  // step count, does not depend on how often the recorder samples.
+  QuarterCar car(parse(quarterCarJson()));
+  SimulationSettings sim;
+  sim.t_end_s = 0.3;
+  sim.integrator.accuracy = 1e-5;
+  int steps[2];
+  const double intervals[2] = {0.1, 0.0005};
+  for (int i = 0; i < 2; ++i) {
+    SimTK::State s = car.makeInitialState();
+    sim.report_interval_s = intervals[i];
+    Recorder rec(car.getScene(), {"chassis.z_m", "chassis.az_m_s2"});
+    steps[i] = simulate(car.getScene(), s, sim, &rec).steps;
+    EXPECT_EQ(rec.size(), static_cast<std::size_t>(std::lround(sim.t_end_s / intervals[i])) + 1);
+    EXPECT_NEAR(rec.time().back(), sim.t_end_s, 1e-12);
+  }
+  EXPECT_EQ(steps[0], steps[1]);
+}
+
+TEST(Recorder, InterpolatedSamplesMatchAStepLandingThere) {
+  // A sample interpolated inside a step agrees with a run that ends exactly at
+  // that time, to the integrator's accuracy.
+  QuarterCar car(parse(quarterCarJson()));
+  SimulationSettings sim;
+  sim.integrator.accuracy = 1e-8;
+  sim.t_end_s = 0.25;
+  sim.report_interval_s = 0.0625;
+  SimTK::State s = car.makeInitialState();
+  Recorder rec(car.getScene(), {"chassis.z_m"});
+  simulate(car.getScene(), s, sim, &rec);
+  SimTK::State s2 = car.makeInitialState();
+  sim.t_end_s = 0.125;
+  simulate(car.getScene(), s2, sim);
+  EXPECT_NEAR(rec.column("chassis.z_m")[2], car.getScene().evalOutput("chassis.z_m", s2), 1e-8);
+}
+
+TEST(Simulation, RejectsEndTimeBeforeStart) {
+  QuarterCar car(parse(quarterCarJson()));
+  SimTK::State s = car.makeInitialState();
+  SimulationSettings sim;
+  sim.t_end_s = -1;
+  EXPECT_EQ(errorOf([&] { simulate(car.getScene(), s, sim); }),
+            "simulate: t_end_s (-1) must be after the start time 0");
+}

@@ -1,0 +1,144 @@
+// Quarter car (seed chapter 4): model size, static equilibrium against a hand
+// force balance, loop closure, energy conservation, integrator agreement.
+#include <cmath>
+
+#include <gtest/gtest.h>
+
+#include "vdyn/core/equilibrium.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/vehicles/quarter_car.h"
+
+using namespace vdyn;
+
+namespace {
+QuarterCarParams nominal() { return QuarterCarParams::fromFile("quarter_car.json"); }
+}  // namespace
+
+TEST(QuarterCar, ModelSize) {
+  const QuarterCar car(nominal());
+  const SimTK::State s = car.makeInitialState(false);
+  // Mobilities: slider 1 + lower arm 1 + knuckle ball 3 + upper arm 1 + spin 1 = 7;
+  // constraints: cut ball 3 + steer lock 1 = 4.
+  EXPECT_EQ(s.getNU(), 7);
+  EXPECT_EQ(car.degreesOfFreedom(s), 3);
+  EXPECT_DOUBLE_EQ(car.totalMass(), 200.0 + 0.5 + 5.0 + 0.5 + 20.0);
+}
+
+TEST(QuarterCar, AssemblyClosesTheTabulatedLoop) {
+  const QuarterCar car(nominal());
+  AssemblyReport rep;
+  const SimTK::State s = car.makeInitialState(false, &rep);
+  // DESIGN.md section 9: the printed front corner is open by about 4 cm.
+  EXPECT_NEAR(rep.initial_loop_gap_m, 0.040, 0.002);
+  EXPECT_LT(positionConstraintError(s), 1e-10);
+  EXPECT_GT(rep.max_move_m, 0.0);
+  EXPECT_LT(rep.max_move_m, 0.05);
+}
+
+TEST(QuarterCar, StaticEquilibriumMatchesHandForceBalance) {
+  const QuarterCar car(nominal());
+  const SimTK::State s0 = car.makeInitialState(true);
+  SimTK::State s = s0;
+  const Scene& sc = car.getScene();
+  sc.getSystem().realize(s, SimTK::Stage::Acceleration);
+  // The slider carries no vertical force, so the tire carries the whole weight:
+  // Fz = (m1 + m2 + m3 + m4 + m_wheel) g, and its deflection is Fz / Kz.
+  const double g = car.params().gravity_m_per_s2;
+  const double W = car.totalMass() * g;
+  const double Fz = sc.evalOutput("tire.Fz_N", s);
+  // The solver's force tolerance (1e-6 N) bounds the imbalance.
+  EXPECT_NEAR(Fz, W, 1e-6);
+  EXPECT_NEAR(sc.evalOutput("tire.deflection_m", s), W / car.params().tire.radial_stiffness_N_per_m, 1e-11);
+  // At rest the tangential tire forces vanish and nothing accelerates.
+  EXPECT_NEAR(sc.evalOutput("tire.Fx_N", s), 0.0, 1e-9);
+  EXPECT_NEAR(sc.evalOutput("tire.Fy_N", s), 0.0, 1e-9);
+  EXPECT_LT(s.getUDot().normInf(), 1e-6);
+  // The spring's free length was set so that this is the tabulated ride height:
+  // the lower arm stays at its assembled angle.
+  const SimTK::State tab = car.makeInitialState(false);
+  EXPECT_NEAR(car.corner().lower_arm.getOneQ(s, 0), car.corner().lower_arm.getOneQ(tab, 0), 1e-9);
+  // A second solve from the solution needs no iteration.
+  SimTK::State again = s0;
+  const auto res = solveStaticEquilibrium(sc, again, car.ineffectiveMobilizers());
+  EXPECT_LE(res.iterations, 1);
+}
+
+TEST(QuarterCar, LoopClosureHoldsThroughTheRun) {
+  QuarterCar car(nominal());
+  SimTK::State s = car.makeInitialState();
+  SimulationSettings sim;
+  sim.t_end_s = 1.0;
+  sim.integrator.accuracy = 1e-6;
+  const RunSummary run = simulate(car.getScene(), s, sim);
+  EXPECT_LE(run.max_constraint_error, 1e-8);
+  EXPECT_GT(run.steps, 10);
+}
+
+TEST(QuarterCar, EnergyIsConservedWithoutDampingOnAFlatRoad) {
+  QuarterCarParams p = nominal();
+  p.road.type = "flat";
+  p.road.amplitude_m = 0;
+  p.corner.damper_N_s_per_m = 0;
+  p.tire.radial_damping_N_s_per_m = 0;
+  // No tangential tire forces: they dissipate whenever the patch slides.
+  p.tire.mu_max = p.tire.mu_min = 0;
+  p.tire.longitudinal_stiffness_N = p.tire.cornering_stiffness_N_per_rad = 0;
+  QuarterCar car(p);
+  SimTK::State s = car.makeInitialState(true);
+  // Lift the chassis 1 cm from equilibrium and let it go.
+  car.chassis().setOneQ(s, 0, car.chassis().getOneQ(s, 0) + 0.01);
+  const SimTK::MultibodySystem& sys = car.getScene().getSystem();
+  sys.realize(s, SimTK::Stage::Dynamics);
+  const double E0 = sys.calcEnergy(s);
+  ASSERT_GT(E0, 100.0);  // ground at z = 0: every body is above it
+  double maxDrift = 0;
+  SimulationSettings sim;
+  sim.t_end_s = 10.0;
+  sim.report_interval_s = 0;
+  sim.integrator.accuracy = 1e-9;
+  const RunSummary run = simulate(car.getScene(), s, sim, nullptr, [&](const SimTK::State& st) {
+    sys.realize(st, SimTK::Stage::Dynamics);
+    maxDrift = std::max(maxDrift, std::abs(sys.calcEnergy(st) - E0));
+  });
+  EXPECT_LE(maxDrift / E0, 1e-6) << "max drift " << maxDrift << " J of " << E0 << " J in " << run.steps << " steps";
+}
+
+TEST(QuarterCar, TwoIntegratorsAgreeToTheirTolerance) {
+  // psi from an explicit 4th-order and an implicit BDF integrator at 1e-8 agree
+  // to a few hundred times that accuracy (global error = local tolerance times
+  // error growth over the run).
+  double psi[2];
+  const char* methods[2] = {"rk_merson", "cpodes"};
+  for (int i = 0; i < 2; ++i) {
+    QuarterCar car(nominal());
+    const IntegralHandle h = car.updScene().addIntegralOfSquare("chassis.az_m_s2");
+    SimTK::State s = car.makeInitialState();
+    SimulationSettings sim;
+    sim.t_end_s = 1.0;
+    sim.integrator.method = methods[i];
+    sim.integrator.accuracy = 1e-8;
+    simulate(car.getScene(), s, sim);
+    psi[i] = car.getScene().getIntegral(h, s);
+  }
+  EXPECT_GT(psi[0], 0.1);
+  EXPECT_NEAR(psi[0], psi[1], 1e-5 * psi[0]) << psi[0] << " vs " << psi[1];
+}
+
+TEST(QuarterCar, CostIntegralMatchesQuadratureOfTheRecordedHistory) {
+  // psi carried as a state equals a fine trapezoidal quadrature of the sampled z''^2.
+  QuarterCar car(nominal());
+  const IntegralHandle h = car.updScene().addIntegralOfSquare("chassis.az_m_s2");
+  SimTK::State s = car.makeInitialState();
+  SimulationSettings sim;
+  sim.t_end_s = 1.0;
+  sim.report_interval_s = 1e-4;
+  sim.integrator.accuracy = 1e-9;
+  Recorder rec(car.getScene(), {"chassis.az_m_s2"});
+  simulate(car.getScene(), s, sim, &rec);
+  const auto& t = rec.time();
+  const auto& a = rec.column("chassis.az_m_s2");
+  double q = 0;
+  for (std::size_t i = 1; i < t.size(); ++i) q += 0.5 * (t[i] - t[i - 1]) * (a[i] * a[i] + a[i - 1] * a[i - 1]);
+  const double psi = car.getScene().getIntegral(h, s);
+  EXPECT_NEAR(psi, q, 1e-5 * psi);
+}
