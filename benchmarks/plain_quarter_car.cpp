@@ -72,15 +72,20 @@ double PlainQuarterCar::run(const Vector& q0, double t_end, double report, const
   integ->setFinalTime(t_end);
   integ->initialize(s);
   if (az) az->clear();
+  State work = s;  // sampling workspace: only t, q, u, z are copied per sample
   for (int k = 0;; ++k) {
     const double t = std::min(t_end, k * report);
     if (k > 0) integ->stepTo(t);
     if (az) {
-      State st = integ->getState();
-      system_.realize(st, Stage::Acceleration);
-      az->push_back(chassis_.getOneUDot(st, 0));
+      const State& is = integ->getState();
+      work.setTime(is.getTime());
+      work.updQ() = is.getQ();
+      work.updU() = is.getU();
+      work.updZ() = is.getZ();
+      system_.realize(work, Stage::Acceleration);
+      az->push_back(chassis_.getOneUDot(work, 0));
     }
-    if (t >= t_end) break;
+    if (t >= t_end - 1e-12) break;
   }
   if (steps) *steps = integ->getNumStepsTaken();
   return psi_.getValue(integ->getState());
