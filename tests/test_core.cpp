@@ -6,25 +6,19 @@
 
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include "vdyn/core/simulation.h"
 #include "vdyn/plugins/builtin.h"
 #include "vdyn/vehicles/quarter_car.h"
 
 using namespace vdyn;
+using vdyn::test::errorOf;
 
 namespace {
 
 /// The quarter-car data file as JSON, to corrupt one key at a time.
 Json quarterCarJson() { return readJsonFile(resolveDataPath("quarter_car.json")); }
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
-}
 
 QuarterCarParams parse(const Json& j) { return QuarterCarParams::fromParams(ParamReader::fromJson(j, "qc.json")); }
 

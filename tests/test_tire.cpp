@@ -15,10 +15,13 @@
 
 #include <gtest/gtest.h>
 
+#include "test_util.h"
+
 #include "vdyn/core/params.h"
 #include "vdyn/tire/tire_model.h"
 
 using namespace vdyn;
+using vdyn::test::errorOf;
 
 namespace {
 
@@ -41,15 +44,6 @@ ContactKinematics contact(const TireModel& m, double Fz, double vx, double vy, d
 /// Longitudinal slip velocity Vx - Omega Re, computed the way the model does.
 double slipVelocity(const TireModel& m, const ContactKinematics& k) {
   return k.vx_m_s - k.spin_rad_s * m.calcRollingRadius(k.deflection_m);
-}
-
-std::string errorOf(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const Error& e) {
-    return e.what();
-  }
-  return "(no error)";
 }
 
 /// All outputs of a TireForces, for finiteness and continuity checks.

@@ -1,0 +1,73 @@
+#pragma once
+// The seed's Appendix A four-wheel-steering vehicle (DESIGN.md section 9): the
+// chassis on a free (6-dof) mobilizer, four double-wishbone corners (the left
+// ones mirrored from the right in the builder), four wheels on spin joints, the
+// suspension spring-dampers and four tire plugins on the scene's road. Steering
+// constraints are plugins added on top (without them each knuckle turns freely
+// about its kingpin: 18 degrees of freedom; with four, 14).
+#include <array>
+#include <memory>
+#include <string>
+
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+#include "vdyn/tire/road.h"
+#include "vdyn/tire/tire_force.h"
+#include "vdyn/vehicles/double_wishbone.h"
+#include "vdyn/vehicles/quarter_car.h"
+
+namespace vdyn {
+
+/// Corner order of the seed's wheel numbering: 14 RF, 15 LF, 16 RR, 17 LR.
+enum Corner { RF = 0, LF = 1, RR = 2, LR = 3 };
+/// "rf", "lf", "rr", "lr": the body-name prefix of each corner.
+const char* cornerName(int corner);
+
+struct FourWsParams {
+  RigidBodyParams chassis;               ///< body 1 (800 kg; 250/1000/1100 kg m^2)
+  DoubleWishboneParams front_right;      ///< bodies 2, 3, 4, 14; LF is its mirror
+  DoubleWishboneParams rear_right;       ///< bodies 8, 9, 10, 16; LR is its mirror
+  std::string tire_plugin = "gim";
+  TireParams tire;
+  RoadParams road;                       ///< flat by default
+  double gravity_m_per_s2 = 9.81;        ///< along -z, m/s^2
+
+  void validate() const;
+  /// Reads a vehicle data file in the layout of appendix_a.json.
+  static FourWsParams fromParams(const ParamReader& r);
+  static FourWsParams fromFile(const std::string& path);
+};
+
+class FourWsVehicle {
+ public:
+  explicit FourWsVehicle(const FourWsParams& params);
+  FourWsVehicle(const FourWsParams& params, const PluginRegistry& registry);
+
+  Scene& updScene() { return *scene_; }
+  const Scene& getScene() const { return *scene_; }
+  const FourWsParams& params() const { return p_; }
+
+  /// The tabulated configuration (chassis c.m. at the height where the tires
+  /// carry about the weight, level, at the origin heading +x), the four loops
+  /// closed by assembly, moving forward at `speed_m_s` with the wheels rolling.
+  SimTK::State makeInitialState(double speed_m_s = 0.0, AssemblyReport* report = nullptr) const;
+
+  double totalMass() const;
+  /// Mobilities minus constraint equations (the chassis quaternion counts as 3).
+  int degreesOfFreedom(const SimTK::State& s) const;
+
+  const SimTK::MobilizedBody::Free& chassis() const { return chassis_; }
+  const DoubleWishboneCorner& corner(int c) const { return corners_.at(c); }
+  const TirePlugin& tire(int c) const { return *tires_.at(c); }
+  const DoubleWishboneParams& cornerParams(int c) const { return cornerParams_.at(c); }
+
+ private:
+  FourWsParams p_;
+  std::unique_ptr<Scene> scene_;
+  SimTK::MobilizedBody::Free chassis_;
+  std::array<DoubleWishboneParams, 4> cornerParams_;
+  std::array<DoubleWishboneCorner, 4> corners_;
+  std::array<const TirePlugin*, 4> tires_{};
+};
+
+}  // namespace vdyn
