@@ -1,5 +1,6 @@
 #include "vdyn/plugins/builtin.h"
 
+#include "vdyn/steering/steering.h"
 #include "vdyn/tire/tire_force.h"
 
 namespace vdyn {
@@ -7,6 +8,7 @@ PluginRegistry& builtinPlugins() {
   static PluginRegistry registry = [] {
     PluginRegistry r;
     registerTirePlugins(r);
+    registerSteeringPlugins(r);
     return r;
   }();
   return registry;

@@ -1,6 +1,9 @@
 // App. A 4WS vehicle builder: model size, masses, loop assembly, mirror symmetry.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <memory>
+
 #include "vdyn/core/simulation.h"
 #include "vdyn/vehicles/fourws.h"
 
@@ -79,5 +82,109 @@ TEST(FourWs, UnknownTirePluginListsKnownOnes) {
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(), "4ws tire plugin: unknown force element plugin 'magic'; known: fiala, gim, linear");
+  }
+}
+
+// --- steering (App. A (A.1)-(A.4)) ------------------------------------------
+
+namespace {
+/// The 4WS vehicle with front and rear steering commands, run to t_end at
+/// 10 m/s; records the chassis and steering outputs every 10 ms.
+struct SteeredRun {
+  std::unique_ptr<FourWsVehicle> car;
+  std::unique_ptr<Recorder> rec;
+  RunSummary run;
+  SimTK::State final;
+};
+
+SteeredRun runSteered(std::shared_ptr<const SteeringCommand> front, std::shared_ptr<const SteeringCommand> rear,
+                      double tEnd) {
+  SteeredRun r;
+  r.car = std::make_unique<FourWsVehicle>(appendixA());
+  r.car->addAxleSteering("front_steer", true, std::move(front));
+  r.car->addAxleSteering("rear_steer", false, std::move(rear));
+  r.final = r.car->makeInitialState(10.0);
+  r.rec = std::make_unique<Recorder>(
+      r.car->getScene(), std::vector<std::string>{"chassis.y_m", "chassis.yaw_rate_rad_s", "front_steer.angle_rad",
+                                                  "front_steer.command_rad", "rear_steer.angle_rad",
+                                                  "rear_steer.command_rad", "rf.spin_rad_s", "lf.spin_rad_s",
+                                                  "rr.spin_rad_s", "lr.spin_rad_s"});
+  SimulationSettings sim;
+  sim.t_end_s = tEnd;
+  sim.report_interval_s = 0.01;
+  sim.integrator.accuracy = 1e-7;
+  r.run = simulate(r.car->getScene(), r.final, sim, r.rec.get());
+  return r;
+}
+
+double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
+  double m = 0;
+  for (std::size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+  return m;
+}
+}  // namespace
+
+TEST(FourWsSteering, FourteenDegreesOfFreedom) {
+  FourWsVehicle car(appendixA());
+  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.0));
+  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.0));
+  const SimTK::State s = car.makeInitialState(10.0);
+  EXPECT_EQ(s.getNUDotErr(), 16);  // 12 loop closure + 4 steering (App. A)
+  EXPECT_EQ(car.degreesOfFreedom(s), 14);
+}
+
+TEST(FourWsSteering, StraightRunStaysStraightAndSymmetric) {
+  const SteeredRun r = runSteered(std::make_shared<HoldCommand>(0.0), std::make_shared<HoldCommand>(0.0), 1.0);
+  const auto& y = r.rec->column("chassis.y_m");
+  double drift = 0;
+  for (double v : y) drift = std::max(drift, std::abs(v));
+  EXPECT_LE(drift, 1e-6);
+  // Left and right wheels of each axle spin alike (mirror-symmetric model).
+  EXPECT_LE(maxAbsDiff(r.rec->column("rf.spin_rad_s"), r.rec->column("lf.spin_rad_s")), 1e-9 * 34);
+  EXPECT_LE(maxAbsDiff(r.rec->column("rr.spin_rad_s"), r.rec->column("lr.spin_rad_s")), 1e-9 * 34);
+  EXPECT_LE(r.run.max_constraint_error, 1e-8);
+}
+
+TEST(FourWsSteering, AngleFollowsTheSmoothStepCommand) {
+  const double d = 4.0 * SimTK::Pi / 180;
+  const SteeredRun r = runSteered(std::make_shared<SmoothStepCommand>(0, d, 0.5, 1.0),
+                                  std::make_shared<SmoothStepCommand>(0, d / 4, 0.5, 1.0), 2.0);
+  EXPECT_LE(maxAbsDiff(r.rec->column("front_steer.angle_rad"), r.rec->column("front_steer.command_rad")), 1e-6);
+  EXPECT_LE(maxAbsDiff(r.rec->column("rear_steer.angle_rad"), r.rec->column("rear_steer.command_rad")), 1e-6);
+  EXPECT_NEAR(r.rec->column("front_steer.angle_rad").back(), d, 1e-6);
+  EXPECT_GT(r.rec->column("chassis.yaw_rate_rad_s").back(), 0.1);  // steering left turns left
+  EXPECT_LE(r.run.max_constraint_error, 1e-8);
+}
+
+TEST(FourWsSteering, OppositeStepsGiveMirroredYawRates) {
+  const double d = 2.0 * SimTK::Pi / 180;
+  const SteeredRun left = runSteered(std::make_shared<SmoothStepCommand>(0, d, 0.2, 0.5),
+                                     std::make_shared<HoldCommand>(0.0), 1.2);
+  const SteeredRun right = runSteered(std::make_shared<SmoothStepCommand>(0, -d, 0.2, 0.5),
+                                      std::make_shared<HoldCommand>(0.0), 1.2);
+  const auto& rl = left.rec->column("chassis.yaw_rate_rad_s");
+  const auto& rr = right.rec->column("chassis.yaw_rate_rad_s");
+  double peak = 0, asym = 0;
+  for (std::size_t i = 0; i < rl.size(); ++i) {
+    peak = std::max(peak, std::abs(rl[i]));
+    asym = std::max(asym, std::abs(rl[i] + rr[i]));
+  }
+  EXPECT_GT(peak, 0.05);
+  EXPECT_LE(asym, 1e-8 * peak);
+}
+
+TEST(FourWsSteering, CommandErrorsAreNamed) {
+  const auto cmd = [](const Json& j) { return makeSteeringCommand(ParamReader::fromJson(j, "scene.json steering")); };
+  try {
+    cmd(Json{{"type", "ramp"}});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "scene.json steering: type: unknown steering command 'ramp'; known: hold, smooth_step");
+  }
+  try {
+    cmd(Json{{"type", "smooth_step"}, {"final_rad", 0.1}, {"start_time_s", 0.5}, {"duration_s", -1.0}});
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "steering duration_s must be positive, got -1");
   }
 }

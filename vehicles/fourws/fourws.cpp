@@ -99,6 +99,15 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
   });
 }
 
+const SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bool front,
+                                                     std::shared_ptr<const SteeringCommand> command) {
+  const int r = front ? RF : RR, l = front ? LF : LR;
+  auto plugin = std::make_unique<SteeringPlugin>(
+      name, "chassis", std::vector<std::string>{std::string(cornerName(r)) + ".knuckle", std::string(cornerName(l)) + ".knuckle"},
+      std::move(command), SimTK::UnitVec3(cornerParams_[r].wheel_spin_axis));
+  return static_cast<const SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
+}
+
 double FourWsVehicle::totalMass() const {
   double m = p_.chassis.mass_kg;
   for (const auto& c : cornerParams_) m += c.lower_arm.mass_kg + c.knuckle.mass_kg + c.upper_arm.mass_kg + c.wheel.mass_kg;

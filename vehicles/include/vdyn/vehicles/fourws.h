@@ -11,6 +11,7 @@
 
 #include "vdyn/core/registry.h"
 #include "vdyn/core/scene.h"
+#include "vdyn/steering/steering.h"
 #include "vdyn/tire/road.h"
 #include "vdyn/tire/tire_force.h"
 #include "vdyn/vehicles/double_wishbone.h"
@@ -51,6 +52,11 @@ class FourWsVehicle {
   /// carry about the weight, level, at the origin heading +x), the four loops
   /// closed by assembly, moving forward at `speed_m_s` with the wheels rolling.
   SimTK::State makeInitialState(double speed_m_s = 0.0, AssemblyReport* report = nullptr) const;
+
+  /// Adds a steering plugin that commands both wheels of the front (or rear)
+  /// axle with the same angle; call before making states.
+  const SteeringPlugin& addAxleSteering(const std::string& name, bool front,
+                                        std::shared_ptr<const SteeringCommand> command);
 
   double totalMass() const;
   /// Mobilities minus constraint equations (the chassis quaternion counts as 3).

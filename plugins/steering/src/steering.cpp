@@ -1,0 +1,161 @@
+#include "vdyn/steering/steering.h"
+
+#include <cmath>
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+SteerCommandValue SteeringCommand::calc(const SimTK::State& s) const {
+  const SteerCommandValue v = DoCalc(s.getTime());
+  assert(std::isfinite(v.angle_rad) && std::isfinite(v.rate_rad_s) && std::isfinite(v.accel_rad_s2));
+  return v;
+}
+
+HoldCommand::HoldCommand(double a) : angle_(requireInRange(a, -1.2, 1.2, "steering hold angle_rad")) {}
+
+SmoothStepCommand::SmoothStepCommand(double d0, double D, double t0, double T)
+    : d0_(requireInRange(d0, -1.2, 1.2, "steering initial_rad")),
+      D_(requireFinite(D, "steering step")),
+      t0_(requireFinite(t0, "steering start_time_s")),
+      T_(requirePositive(T, "steering duration_s")) {
+  requireInRange(d0 + D, -1.2, 1.2, "steering final_rad");
+}
+
+SteerCommandValue SmoothStepCommand::DoCalc(double t) const {
+  if (t <= t0_) return {d0_, 0, 0};
+  if (t >= t0_ + T_) return {d0_ + D_, 0, 0};
+  const double s = (t - t0_) / T_;
+  // (7.4) and its derivatives: d/ds = 12 s (1 - s)^2, d2/ds2 = 12 - 48 s + 36 s^2.
+  return {d0_ + D_ * s * s * (6 - 8 * s + 3 * s * s), D_ / T_ * 12 * s * (1 - s) * (1 - s),
+          D_ / (T_ * T_) * (12 - 48 * s + 36 * s * s)};
+}
+
+std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r) {
+  const std::string type = r.string("type");
+  if (type == "hold") return std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
+  if (type == "smooth_step") {
+    const double d0 = r.numberOr("initial_rad", 0.0);
+    return std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
+                                               r.number("duration_s"));
+  }
+  throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step");
+}
+
+// ---------------------------------------------------------------------------
+SteeringConstraintImpl::SteeringConstraintImpl(SimTK::SimbodyMatterSubsystem& matter,
+                                               const SimTK::MobilizedBody& chassis,
+                                               const SimTK::MobilizedBody& knuckle,
+                                               const SimTK::UnitVec3& spinAxis_K,
+                                               std::shared_ptr<const SteeringCommand> command)
+    : Implementation(matter, 1, 0, 0), spin_K_(spinAxis_K), command_(std::move(command)) {
+  if (!command_) throw Error("steering constraint: no command");
+  B_ = addConstrainedBody(chassis);
+  F_ = addConstrainedBody(knuckle);
+}
+
+// Notation (all in the constraint's ancestor frame A): b = chassis x axis,
+// f = knuckle spin axis, w_B, w_F their angular velocities.
+void SteeringConstraintImpl::calcPositionErrors(
+    const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
+    const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&, SimTK::Array_<SimTK::Real>& perr) const {
+  const Vec3 b = getBodyRotation(X_AB, B_).x();
+  const Vec3 f = getBodyRotation(X_AB, F_) * Vec3(spin_K_);
+  perr[0] = SimTK::dot(b, f) + std::sin(command_->calc(s).angle_rad);
+}
+
+void SteeringConstraintImpl::calcPositionDotErrors(
+    const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
+    const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&, SimTK::Array_<SimTK::Real>& pverr) const {
+  const Vec3 b = getBodyRotationFromState(s, B_).x();
+  const Vec3 f = getBodyRotationFromState(s, F_) * Vec3(spin_K_);
+  const Vec3 w_B = getBodyAngularVelocity(V_AB, B_), w_F = getBodyAngularVelocity(V_AB, F_);
+  const SteerCommandValue c = command_->calc(s);
+  // d/dt (b . f) = (w_F - w_B) . (f x b)
+  pverr[0] = SimTK::dot(w_F - w_B, SimTK::cross(f, b)) + std::cos(c.angle_rad) * c.rate_rad_s;
+}
+
+void SteeringConstraintImpl::calcPositionDotDotErrors(
+    const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
+    const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&, SimTK::Array_<SimTK::Real>& paerr) const {
+  const Vec3 b = getBodyRotationFromState(s, B_).x();
+  const Vec3 f = getBodyRotationFromState(s, F_) * Vec3(spin_K_);
+  const Vec3 w_B = getBodyAngularVelocityFromState(s, B_), w_F = getBodyAngularVelocityFromState(s, F_);
+  const Vec3 a_B = getBodyAngularAcceleration(A_AB, B_), a_F = getBodyAngularAcceleration(A_AB, F_);
+  const Vec3 bdot = SimTK::cross(w_B, b), fdot = SimTK::cross(w_F, f);
+  const SteerCommandValue c = command_->calc(s);
+  // (A.3)-(A.4): the second derivative of Phi, with the commanded acceleration.
+  paerr[0] = SimTK::dot(a_F - a_B, SimTK::cross(f, b)) +
+             SimTK::dot(w_F - w_B, SimTK::cross(fdot, b) + SimTK::cross(f, bdot)) +
+             std::cos(c.angle_rad) * c.accel_rad_s2 - std::sin(c.angle_rad) * c.rate_rad_s * c.rate_rad_s;
+}
+
+void SteeringConstraintImpl::addInPositionConstraintForces(
+    const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
+    SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
+    SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&) const {
+  const Vec3 b = getBodyRotationFromState(s, B_).x();
+  const Vec3 f = getBodyRotationFromState(s, F_) * Vec3(spin_K_);
+  // Torques whose power equals lambda times the velocity-level error.
+  const Vec3 torque_F = multipliers[0] * SimTK::cross(f, b);
+  addInBodyTorque(s, F_, torque_F, bodyForcesInA);
+  addInBodyTorque(s, B_, -torque_F, bodyForcesInA);
+}
+
+double steeringAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& knuckle,
+                     const SimTK::UnitVec3& spinAxis_K) {
+  const Vec3 b = chassis.getBodyRotation(s).x();
+  const Vec3 f = knuckle.getBodyRotation(s) * Vec3(spinAxis_K);
+  return std::asin(std::max(-1.0, std::min(1.0, -SimTK::dot(b, f))));
+}
+
+// ---------------------------------------------------------------------------
+SteeringPlugin::SteeringPlugin(std::string name, std::string chassisBody, std::vector<std::string> knuckles,
+                               std::shared_ptr<const SteeringCommand> command, SimTK::UnitVec3 spinAxis_K)
+    : ConstraintPlugin("steering", std::move(name)),
+      chassis_(std::move(chassisBody)),
+      knuckles_(std::move(knuckles)),
+      command_(std::move(command)),
+      spin_K_(spinAxis_K) {
+  if (!command_) throw Error("steering plugin '" + this->name() + "': no command");
+  if (knuckles_.empty()) throw Error("steering plugin '" + this->name() + "': no knuckles listed");
+}
+
+void SteeringPlugin::DoAddTo(Scene& scene) {
+  const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
+  for (const auto& k : knuckles_)
+    SimTK::Constraint::Custom(
+        new SteeringConstraintImpl(scene.updMatter(), chassis, scene.getBody(k), spin_K_, command_));
+  const auto cmd = command_;
+  scene.addOutput({name() + ".command_rad", "rad", SimTK::Stage::Time,
+                   [cmd](const SimTK::State& s) { return cmd->calc(s).angle_rad; }});
+  const SimTK::MobilizedBody first = scene.getBody(knuckles_.front());
+  const SimTK::UnitVec3 axis = spin_K_;
+  scene.addOutput({name() + ".angle_rad", "rad", SimTK::Stage::Position,
+                   [chassis, first, axis](const SimTK::State& s) { return steeringAngle(s, chassis, first, axis); }});
+}
+
+void registerSteeringPlugins(PluginRegistry& registry) {
+  registry.add(PluginKind::Constraint, "steering", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+    std::vector<std::string> knuckles;
+    if (spec.bindings.count("knuckles")) {
+      std::string list = spec.bindings.at("knuckles"), item;
+      for (std::size_t pos = 0; pos <= list.size(); ++pos) {
+        if (pos == list.size() || list[pos] == ',') {
+          if (!item.empty()) knuckles.push_back(item);
+          item.clear();
+        } else {
+          item += list[pos];
+        }
+      }
+    } else {
+      const Json& j = spec.params.json().at("knuckles");
+      for (const auto& k : j) knuckles.push_back(k.get<std::string>());
+    }
+    return std::make_unique<SteeringPlugin>(
+        spec.name, spec.bound("chassis"), knuckles, makeSteeringCommand(spec.params.child("command")),
+        SimTK::UnitVec3(spec.params.vec3Or("spin_axis", Vec3(0, 1, 0))));
+  });
+}
+
+}  // namespace vdyn
