@@ -1,5 +1,6 @@
 #include "vdyn/plugins/builtin.h"
 
+#include "vdyn/speed/speed_hold.h"
 #include "vdyn/steering/steering.h"
 #include "vdyn/tire/tire_force.h"
 
@@ -9,6 +10,7 @@ PluginRegistry& builtinPlugins() {
     PluginRegistry r;
     registerTirePlugins(r);
     registerSteeringPlugins(r);
+    registerSpeedPlugins(r);
     return r;
   }();
   return registry;

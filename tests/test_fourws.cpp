@@ -5,6 +5,7 @@
 #include <memory>
 
 #include "vdyn/core/simulation.h"
+#include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/fourws.h"
 
 using namespace vdyn;
@@ -186,5 +187,38 @@ TEST(FourWsSteering, CommandErrorsAreNamed) {
     FAIL() << "no error";
   } catch (const Error& e) {
     EXPECT_STREQ(e.what(), "steering duration_s must be positive, got -1");
+  }
+}
+
+// --- speed hold (3.18) --------------------------------------------------------
+
+TEST(FourWsSpeedHold, HoldsTheSpeedThroughATurnAndReportsItsForce) {
+  FourWsVehicle car(appendixA());
+  const double d = 4.0 * SimTK::Pi / 180;
+  car.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, d, 0.2, 0.5));
+  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.0));
+  car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
+  SimTK::State s = car.makeInitialState(10.0);
+  EXPECT_EQ(car.degreesOfFreedom(s), 13);  // 14 less the speed condition
+  SimulationSettings sim;
+  sim.t_end_s = 2.0;
+  sim.report_interval_s = 0.05;
+  sim.integrator.accuracy = 1e-7;
+  Recorder rec(car.getScene(), {"chassis.forward_speed_m_s", "chassis.lateral_speed_m_s", "speed_hold.force_N"});
+  simulate(car.getScene(), s, sim, &rec);
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const double vx = rec.column("chassis.forward_speed_m_s")[i], vy = rec.column("chassis.lateral_speed_m_s")[i];
+    EXPECT_NEAR(std::hypot(vx, vy), 10.0, 1e-7) << "t = " << rec.time()[i];
+  }
+  // Cornering drag of the tires needs a propulsive force (rolling resistance is 0).
+  EXPECT_GT(rec.column("speed_hold.force_N").back(), 10.0);
+}
+
+TEST(FourWsSpeedHold, RejectsANonPositiveSpeed) {
+  try {
+    SpeedHoldPlugin p("speed_hold", "chassis", -3.0);
+    FAIL() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "speed hold speed_m_s must be positive, got -3");
   }
 }

@@ -1,0 +1,61 @@
+#pragma once
+// Constant vehicle speed, the seed's (3.18): K = v_xi^2 + v_eta^2 - U0^2 = 0,
+// with v_xi, v_eta the velocity of the chassis origin along the chassis xi and
+// eta axes. One nonholonomic constraint, scaled by 1 / (2 U0) so its error is in
+// m/s. Its force acts at the chassis origin along (v_xi e_xi + v_eta e_eta) / U0
+// (the constraint's gradient), and its multiplier is the force it takes to hold
+// the speed: output <name>.force_N (> 0 propulsive, N).
+#include <memory>
+#include <string>
+
+#include <Simbody.h>
+
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+
+namespace vdyn {
+
+class SpeedHoldImpl : public SimTK::Constraint::Custom::Implementation {
+ public:
+  SpeedHoldImpl(SimTK::SimbodyMatterSubsystem& matter, const SimTK::MobilizedBody& chassis, double speed_m_s);
+  Implementation* clone() const override { return new SpeedHoldImpl(*this); }
+
+  void calcVelocityErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
+                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedUIndex>&,
+                          SimTK::Array_<SimTK::Real>& verr) const override;
+  void calcVelocityDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
+                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedUIndex>&,
+                             SimTK::Array_<SimTK::Real>& vaerr) const override;
+  void addInVelocityConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
+                                     SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
+                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedUIndex>& mobilityForces) const override;
+
+ private:
+  /// Unit-free direction (v_xi e_xi + v_eta e_eta) / U0 in A for a chassis velocity.
+  SimTK::Vec3 direction(const SimTK::Rotation& R_AB, const SimTK::Vec3& v_AB) const;
+  SimTK::ConstrainedBodyIndex G_, B_;
+  double U0_;
+};
+
+class SpeedHoldPlugin : public ConstraintPlugin {
+ public:
+  /// speed_m_s > 0: the forward speed U0 held on the named chassis body.
+  SpeedHoldPlugin(std::string name, std::string chassisBody, double speed_m_s);
+  double speed() const { return U0_; }
+  /// Force the constraint applies along the direction of travel, N (needs
+  /// Stage::Acceleration).
+  double calcForce(const SimTK::State& s) const;
+
+ protected:
+  void DoAddTo(Scene& scene) override;
+
+ private:
+  std::string chassis_;
+  double U0_;
+  SimTK::Constraint::Custom constraint_;
+};
+
+/// Registers "speed_hold": {"chassis": "chassis", "speed_m_s": 10}.
+void registerSpeedPlugins(PluginRegistry& registry);
+
+}  // namespace vdyn
