@@ -1,0 +1,114 @@
+// ch3_transient: the seed's chapter 3 transient run of the App. A 4WS vehicle
+// (section 3.3): constant speed (3.18), front and rear wheels steered left by a
+// smooth step (7.4) from 0.5 s, run until steady. Writes the histories (CSV,
+// PNG) and summary.json with the final values.
+#include <cmath>
+#include <cstdio>
+
+#include "study.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/vehicles/fourws.h"
+
+using namespace vdyn;
+
+int main(int argc, char** argv) {
+  return study::run("ch3_transient", [&] {
+    namespace po = study::po;
+    po::options_description opts("Options");
+    opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file")(
+        "speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
+        "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
+        "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
+        "t-end-s", po::value<double>(), "simulated time, s (default 20)")(
+        "integrator", po::value<std::string>(), "rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
+        "accuracy", po::value<double>(), "integrator relative accuracy")("no-plots", "skip the PNG plots");
+    const auto vm = study::parse("ch3_transient", "chapter 3 transient of the 4WS vehicle (steer step at constant speed)",
+                                 argc, argv, opts);
+    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    const double deg = SimTK::Pi / 180;
+    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
+    const double front = vm.count("front-deg") ? vm["front-deg"].as<double>() * deg : data.number("front_angle_rad");
+    const double rear = vm.count("rear-deg") ? vm["rear-deg"].as<double>() * deg : data.number("rear_angle_rad");
+    const double t0 = data.number("steer_start_time_s"), T = data.number("steer_duration_s");
+    SimulationSettings sim;
+    const ParamReader simData = data.child("simulation");
+    sim.t_end_s = vm.count("t-end-s") ? vm["t-end-s"].as<double>() : simData.number("t_end_s");
+    sim.report_interval_s = simData.number("report_interval_s");
+    sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
+    if (vm.count("integrator")) sim.integrator.method = vm["integrator"].as<std::string>();
+    if (vm.count("accuracy")) sim.integrator.accuracy = vm["accuracy"].as<double>();
+    requirePositive(U0, "--speed-m-s");
+    requirePositive(sim.t_end_s, "--t-end-s");
+    const std::string out = study::outputDir(vm, "ch3_transient");
+
+    FourWsVehicle car(FourWsParams::fromFile(data.string("vehicle_data")));
+    car.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, front, t0, T));
+    car.addAxleSteering("rear_steer", false, std::make_shared<SmoothStepCommand>(0, rear, t0, T));
+    car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
+    AssemblyReport assembly;
+    SimTK::State s = car.makeInitialState(U0, &assembly);
+    const int dof = car.degreesOfFreedom(s);
+
+    const std::vector<std::string> cols = {
+        "chassis.x_m", "chassis.y_m", "chassis.z_m", "chassis.roll_rad", "chassis.pitch_rad", "chassis.yaw_rad",
+        "chassis.roll_rate_rad_s", "chassis.pitch_rate_rad_s", "chassis.yaw_rate_rad_s", "chassis.side_slip_rad",
+        "rf.spin_rad_s", "lf.spin_rad_s", "rr.spin_rad_s", "lr.spin_rad_s", "front_steer.angle_rad",
+        "rear_steer.angle_rad", "speed_hold.force_N"};
+    Recorder rec(car.getScene(), cols);
+    const RunSummary run = simulate(car.getScene(), s, sim, &rec);
+    const std::string csv = out + "/history.csv";
+    rec.writeCsv(csv);
+
+    const Scene& sc = car.getScene();
+    auto fin = [&](const std::string& n) { return sc.evalOutput(n, s); };
+    const double r = fin("chassis.yaw_rate_rad_s");
+    Json summary = {{"yaw_rate_rad_s", r},
+                    {"roll_rate_rad_s", fin("chassis.roll_rate_rad_s")},
+                    {"pitch_rate_rad_s", fin("chassis.pitch_rate_rad_s")},
+                    {"roll_rad", fin("chassis.roll_rad")},
+                    {"pitch_rad", fin("chassis.pitch_rad")},
+                    {"chassis_z_m", fin("chassis.z_m")},
+                    {"wheel_spin_rad_s", {fin("rf.spin_rad_s"), fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s")}},
+                    {"path_radius_m", U0 / r},
+                    {"side_slip_rad", fin("chassis.side_slip_rad")},
+                    {"speed_hold_force_N", fin("speed_hold.force_N")},
+                    {"dof", dof},
+                    {"total_mass_kg", car.totalMass()},
+                    {"max_constraint_error", run.max_constraint_error},
+                    {"sim_time_s", run.sim_time_s},
+                    {"wall_time_s", run.wall_time_s},
+                    {"real_time_factor", run.sim_time_s / run.wall_time_s},
+                    {"steps", run.steps},
+                    {"integrator", run.integrator},
+                    {"accuracy", run.accuracy},
+                    {"assembly_max_body_move_m", assembly.max_move_m}};
+    study::writeJson(out + "/summary.json", summary);
+    if (!vm.count("no-plots")) {
+      study::plot({{out + "/rates.png", "Chassis roll, pitch and yaw rate", "t (s)", "rate (rad/s)",
+                    {{csv, "t_s", "chassis.roll_rate_rad_s", "roll rate"},
+                     {csv, "t_s", "chassis.pitch_rate_rad_s", "pitch rate"},
+                     {csv, "t_s", "chassis.yaw_rate_rad_s", "yaw rate"}}},
+                   {out + "/wheel_spins.png", "Wheel spin rates", "t (s)", "spin (rad/s)",
+                    {{csv, "t_s", "rf.spin_rad_s", "RF"}, {csv, "t_s", "lf.spin_rad_s", "LF"},
+                     {csv, "t_s", "rr.spin_rad_s", "RR"}, {csv, "t_s", "lr.spin_rad_s", "LR"}}},
+                   {out + "/chassis_height.png", "Chassis centre-of-mass height", "t (s)", "z (m)",
+                    {{csv, "t_s", "chassis.z_m", "z"}}},
+                   {out + "/trajectory.png", "Trajectory of the chassis centre of mass", "x (m)", "y (m)",
+                    {{csv, "chassis.x_m", "chassis.y_m", "path"}}, true}});
+    }
+    std::printf("ch3_transient: U0 = %g m/s, front %.3f deg, rear %.3f deg, %s at %g, T = %g s\n", U0, front / deg,
+                rear / deg, run.integrator.c_str(), run.accuracy, sim.t_end_s);
+    std::printf("  yaw rate            %.6f rad/s (path radius %.3f m)\n", r, U0 / r);
+    std::printf("  roll / pitch        %.6f / %.6f rad (rates %.2e / %.2e rad/s)\n", fin("chassis.roll_rad"),
+                fin("chassis.pitch_rad"), fin("chassis.roll_rate_rad_s"), fin("chassis.pitch_rate_rad_s"));
+    std::printf("  chassis height      %.6f m; side slip %.6f rad; speed-hold force %.2f N\n", fin("chassis.z_m"),
+                fin("chassis.side_slip_rad"), fin("speed_hold.force_N"));
+    std::printf("  wheel spins         RF %.4f LF %.4f RR %.4f LR %.4f rad/s\n", fin("rf.spin_rad_s"),
+                fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s"));
+    std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, %d steps\n", dof, car.totalMass(),
+                run.max_constraint_error, run.steps);
+    std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
+                run.sim_time_s / run.wall_time_s);
+  });
+}
