@@ -54,7 +54,7 @@ int main(int argc, char** argv) {
         "chassis.x_m", "chassis.y_m", "chassis.z_m", "chassis.roll_rad", "chassis.pitch_rad", "chassis.yaw_rad",
         "chassis.roll_rate_rad_s", "chassis.pitch_rate_rad_s", "chassis.yaw_rate_rad_s", "chassis.side_slip_rad",
         "rf.spin_rad_s", "lf.spin_rad_s", "rr.spin_rad_s", "lr.spin_rad_s", "front_steer.angle_rad",
-        "rear_steer.angle_rad", "speed_hold.force_N"};
+        "rear_steer.angle_rad"};  // all at Stage::Velocity: sampling never realizes accelerations
     Recorder rec(car.getScene(), cols);
     const RunSummary run = simulate(car.getScene(), s, sim, &rec);
     const std::string csv = out + "/history.csv";
