@@ -12,19 +12,15 @@
 #include <fstream>
 #include <sstream>
 
+#include "bench_util.h"
 #include "plain_quarter_car.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
 
 using namespace vdyn;
+using vdyn::bench::median;
 
 namespace {
-
-double median(std::vector<double> v) {
-  std::sort(v.begin(), v.end());
-  const std::size_t n = v.size();
-  return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
 
 struct Result {
   double psi = 0;
@@ -51,22 +47,6 @@ Result runFramework(QuarterCar& car, IntegralHandle h, const SimTK::State& s0, c
   r.az = rec.column("chassis.az_m_s2");
   r.steps = run.steps;
   return r;
-}
-
-std::vector<double> parseList(const std::string& s) {
-  std::vector<double> v;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) v.push_back(std::stod(item));
-  return v;
-}
-
-std::vector<std::string> parseNames(const std::string& s) {
-  std::vector<std::string> v;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ',')) v.push_back(item);
-  return v;
 }
 
 }  // namespace
@@ -111,8 +91,8 @@ int main(int argc, char** argv) {
     csv << "integrator,accuracy,steps,wall_time_s,error_az,error_psi,psi\n";
     std::printf("\n%-22s %9s %8s %12s %11s %11s\n", "integrator", "accuracy", "steps", "wall (ms)", "err z''", "err psi");
     Json table = Json::array();
-    for (const auto& method : parseNames(vm["integrators"].as<std::string>())) {
-      for (double acc : parseList(vm["accuracies"].as<std::string>())) {
+    for (const auto& method : bench::splitList(vm["integrators"].as<std::string>())) {
+      for (double acc : bench::splitNumbers(vm["accuracies"].as<std::string>())) {
         std::vector<double> walls;
         Result r;
         for (int k = 0; k < repeats; ++k) {
@@ -170,7 +150,7 @@ int main(int argc, char** argv) {
     if (!vm.count("no-plots")) {
       // One CSV per integrator for the plot.
       std::vector<study::Series> series;
-      for (const auto& method : parseNames(vm["integrators"].as<std::string>())) {
+      for (const auto& method : bench::splitList(vm["integrators"].as<std::string>())) {
         const std::string f = out + "/wp_" + method + ".csv";
         std::ofstream o(f);
         o << "wall_time_s,error_az\n";

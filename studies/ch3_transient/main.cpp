@@ -54,12 +54,19 @@ int main(int argc, char** argv) {
         "chassis.x_m", "chassis.y_m", "chassis.z_m", "chassis.roll_rad", "chassis.pitch_rad", "chassis.yaw_rad",
         "chassis.roll_rate_rad_s", "chassis.pitch_rate_rad_s", "chassis.yaw_rate_rad_s", "chassis.side_slip_rad",
         "rf.spin_rad_s", "lf.spin_rad_s", "rr.spin_rad_s", "lr.spin_rad_s", "front_steer.angle_rad",
-        "rear_steer.angle_rad"};  // all at Stage::Velocity: sampling never realizes accelerations
+        "rear_steer.angle_rad", "front_steer.command_rad", "rear_steer.command_rad"};
+    // (all at Stage::Velocity or lower: sampling never realizes accelerations)
     Recorder rec(car.getScene(), cols);
     const RunSummary run = simulate(car.getScene(), s, sim, &rec);
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
 
+    double steerError = 0;  // largest |angle - command| over the samples, both axles
+    for (const char* axle : {"front_steer", "rear_steer"}) {
+      const auto& a = rec.column(std::string(axle) + ".angle_rad");
+      const auto& c = rec.column(std::string(axle) + ".command_rad");
+      for (std::size_t i = 0; i < a.size(); ++i) steerError = std::max(steerError, std::abs(a[i] - c[i]));
+    }
     const Scene& sc = car.getScene();
     auto fin = [&](const std::string& n) { return sc.evalOutput(n, s); };
     const double r = fin("chassis.yaw_rate_rad_s");
@@ -76,6 +83,7 @@ int main(int argc, char** argv) {
                     {"dof", dof},
                     {"total_mass_kg", car.totalMass()},
                     {"max_constraint_error", run.max_constraint_error},
+                    {"max_steer_error_rad", steerError},
                     {"sim_time_s", run.sim_time_s},
                     {"wall_time_s", run.wall_time_s},
                     {"real_time_factor", run.sim_time_s / run.wall_time_s},
@@ -106,8 +114,8 @@ int main(int argc, char** argv) {
                 fin("chassis.side_slip_rad"), fin("speed_hold.force_N"));
     std::printf("  wheel spins         RF %.4f LF %.4f RR %.4f LR %.4f rad/s\n", fin("rf.spin_rad_s"),
                 fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s"));
-    std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, %d steps\n", dof, car.totalMass(),
-                run.max_constraint_error, run.steps);
+    std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, max |steer - command| %.2e rad, %d steps\n", dof,
+                car.totalMass(), run.max_constraint_error, steerError, run.steps);
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
   });
