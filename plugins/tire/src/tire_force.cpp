@@ -7,16 +7,20 @@ namespace vdyn {
 using SimTK::Vec3;
 
 TireForceImpl::TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
-                             std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W)
-    : wheel_(wheel), model_(std::move(model)), road_(std::move(road)), spinAxis_W_(spinAxis_W) {
+                             std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W,
+                             const Vec3& centre_W)
+    : wheel_(wheel), model_(std::move(model)), road_(std::move(road)), spinAxis_W_(spinAxis_W), centre_W_(centre_W) {
   if (!model_) throw Error("tire force element: no tire model");
   if (!road_) throw Error("tire force element: no road");
+  // The centre must lie on the spin axis, or spinning would move it.
+  if ((centre_W_ - SimTK::dot(centre_W_, Vec3(spinAxis_W_)) * Vec3(spinAxis_W_)).norm() > 1e-12)
+    throw Error("tire centre_m must lie on the wheel's spin axis");
 }
 
 TireForceImpl::Geometry TireForceImpl::calcGeometry(const SimTK::State& s) const {
   Geometry g;
   const SimTK::Transform& X_GW = wheel_.getBodyTransform(s);
-  const Vec3& p_GW = X_GW.p();
+  const Vec3 p_GW = X_GW * centre_W_;  // tire centre
   const Vec3 s_G = X_GW.R() * Vec3(spinAxis_W_);
   const double t = s.getTime();
   const Vec3 n = Vec3(road_->normal(p_GW[0], p_GW[1], t));
@@ -48,8 +52,8 @@ TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
   c.p_GC = g.p_GC;
   c.R_GC = g.R_GC;
   const double deflection = g.deflection, camber = g.camber;
-  const Vec3 p_GW = wheel_.getBodyOriginLocation(s);
-  const Vec3 v_GW = wheel_.getBodyOriginVelocity(s);
+  const Vec3 p_GW = wheel_.findStationLocationInGround(s, centre_W_);  // tire centre
+  const Vec3 v_GW = wheel_.findStationVelocityInGround(s, centre_W_);
   const Vec3 w_GW = wheel_.getBodyAngularVelocity(s);
   const Vec3 s_G = wheel_.getBodyRotation(s) * Vec3(spinAxis_W_);
   const Vec3 n = c.R_GC.z();
@@ -76,7 +80,7 @@ void TireForceImpl::calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::Spati
   const Vec3 F_G = c.R_GC * Vec3(f.fx_N, f.fy_N, f.fz_N);
   const Vec3 s_G = wheel_.getBodyRotation(s) * Vec3(spinAxis_W_);
   const Vec3 M_G = f.mz_N_m * c.R_GC.z() + f.my_N_m * s_G;
-  const Vec3 r_GP = c.p_GC - wheel_.getBodyOriginLocation(s);
+  const Vec3 r_GP = c.p_GC - wheel_.getBodyOriginLocation(s);  // moment about the body origin
   bodyForces[wheel_.getMobilizedBodyIndex()] += SimTK::SpatialVec(M_G + SimTK::cross(r_GP, F_G), F_G);
 }
 
@@ -88,12 +92,13 @@ SimTK::Real TireForceImpl::calcPotentialEnergy(const SimTK::State& s) const {
 // ---------------------------------------------------------------------------
 TirePlugin::TirePlugin(std::string type, std::string name, std::string wheelBody,
                        std::shared_ptr<const TireModel> model, SimTK::UnitVec3 spinAxis_W,
-                       std::string roadService)
+                       std::string roadService, SimTK::Vec3 centre_W)
     : ForceElementPlugin(std::move(type), std::move(name)),
       wheelBody_(std::move(wheelBody)),
       model_(std::move(model)),
       spinAxis_W_(spinAxis_W),
-      roadService_(std::move(roadService)) {
+      roadService_(std::move(roadService)),
+      centre_W_(centre_W) {
   if (!model_) throw Error("tire plugin '" + this->name() + "': no tire model");
 }
 
@@ -105,7 +110,7 @@ const TireForceImpl& TirePlugin::getForceElement() const {
 void TirePlugin::DoAddTo(Scene& scene) {
   const SimTK::MobilizedBody& wheel = scene.getBody(wheelBody_);
   auto road = scene.getService<const Road>(roadService_);
-  auto* impl = new TireForceImpl(wheel, model_, road, spinAxis_W_);
+  auto* impl = new TireForceImpl(wheel, model_, road, spinAxis_W_, centre_W_);
   SimTK::Force::Custom(scene.updForces(), impl);  // the subsystem owns impl
   impl_ = impl;
   const TireForceImpl* e = impl;
@@ -129,7 +134,8 @@ void registerTirePlugins(PluginRegistry& registry) {
                                                      : TireParams{};
       return std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"),
                                           makeTireModel(type, p),
-                                          SimTK::UnitVec3(spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0))));
+                                          SimTK::UnitVec3(spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0))),
+                                          "road", spec.params.vec3Or("centre_m", SimTK::Vec3(0)));
     });
   }
 }

@@ -21,12 +21,15 @@ struct TireContact {
   TireForces forces;         ///< in C, acting on the wheel
 };
 
-/// Force::Custom implementation: wheel W (origin at the wheel centre, spin axis
-/// `spinAxis_W`), a torus of radii R1, R2 against the road height field.
+/// Force::Custom implementation: wheel W (spin axis `spinAxis_W` through the
+/// origin), a torus of radii R1, R2 centred at `centre_W` on the spin axis
+/// (the origin by default; an offset puts two tires on one axle body), against
+/// the road height field.
 class TireForceImpl : public SimTK::Force::Custom::Implementation {
  public:
   TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
-                std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W);
+                std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W,
+                const SimTK::Vec3& centre_W = SimTK::Vec3(0));
 
   /// Needs Stage::Velocity (and Time) realized.
   TireContact calcContact(const SimTK::State& state) const;
@@ -52,6 +55,7 @@ class TireForceImpl : public SimTK::Force::Custom::Implementation {
   std::shared_ptr<const TireModel> model_;
   std::shared_ptr<const Road> road_;
   SimTK::UnitVec3 spinAxis_W_;
+  SimTK::Vec3 centre_W_;
 };
 
 /// Tire plugin: attaches a TireModel to a named wheel body of the scene, on the
@@ -62,7 +66,7 @@ class TirePlugin : public ForceElementPlugin {
   TirePlugin(std::string type, std::string name, std::string wheelBody,
              std::shared_ptr<const TireModel> model,
              SimTK::UnitVec3 spinAxis_W = SimTK::UnitVec3(SimTK::YAxis),
-             std::string roadService = "road");
+             std::string roadService = "road", SimTK::Vec3 centre_W = SimTK::Vec3(0));
 
   /// Valid after the plugin was added to a scene.
   const TireForceImpl& getForceElement() const;
@@ -77,11 +81,13 @@ class TirePlugin : public ForceElementPlugin {
   std::shared_ptr<const TireModel> model_;
   SimTK::UnitVec3 spinAxis_W_;
   std::string roadService_;
+  SimTK::Vec3 centre_W_;
   const TireForceImpl* impl_ = nullptr;  // owned by the Simbody force subsystem
 };
 
 /// Registers the tire plugins "gim", "fiala" and "linear". Parameters:
-/// {"wheel": "<body name>", "params": {TireParams keys}}.
+/// {"wheel": "<body name>", "params": {TireParams keys}, "spin_axis": [0, 1, 0],
+///  "centre_m": [0, 0, 0] (tire centre on the wheel body's spin axis, m)}.
 void registerTirePlugins(PluginRegistry& registry);
 
 }  // namespace vdyn
