@@ -9,12 +9,23 @@ using SimTK::Vec3;
 TireForceImpl::TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
                              std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W,
                              const Vec3& centre_W)
-    : wheel_(wheel), model_(std::move(model)), road_(std::move(road)), spinAxis_W_(spinAxis_W), centre_W_(centre_W) {
+    : TireForceImpl(wheel, std::move(model), std::move(road), spinAxis_W, centre_W, centre_W) {}
+
+TireForceImpl::TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
+                             std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W,
+                             const Vec3& centre_W, const Vec3& slipCentre_W)
+    : wheel_(wheel),
+      model_(std::move(model)),
+      road_(std::move(road)),
+      spinAxis_W_(spinAxis_W),
+      centre_W_(centre_W),
+      slipCentre_W_(slipCentre_W) {
   if (!model_) throw Error("tire force element: no tire model");
   if (!road_) throw Error("tire force element: no road");
   // The centre must lie on the spin axis, or spinning would move it.
-  if ((centre_W_ - SimTK::dot(centre_W_, Vec3(spinAxis_W_)) * Vec3(spinAxis_W_)).norm() > 1e-12)
-    throw Error("tire centre_m must lie on the wheel's spin axis");
+  for (const Vec3& c : {centre_W_, slipCentre_W_})
+    if ((c - SimTK::dot(c, Vec3(spinAxis_W_)) * Vec3(spinAxis_W_)).norm() > 1e-12)
+      throw Error("tire centre_m and slip_centre_m must lie on the wheel's spin axis");
 }
 
 TireForceImpl::Geometry TireForceImpl::calcGeometry(const SimTK::State& s) const {
@@ -54,6 +65,7 @@ TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
   const double deflection = g.deflection, camber = g.camber;
   const Vec3 p_GW = wheel_.findStationLocationInGround(s, centre_W_);  // tire centre
   const Vec3 v_GW = wheel_.findStationVelocityInGround(s, centre_W_);
+  const Vec3 v_slip = slipCentre_W_ == centre_W_ ? v_GW : wheel_.findStationVelocityInGround(s, slipCentre_W_);
   const Vec3 w_GW = wheel_.getBodyAngularVelocity(s);
   const Vec3 s_G = wheel_.getBodyRotation(s) * Vec3(spinAxis_W_);
   const Vec3 n = c.R_GC.z();
@@ -64,8 +76,8 @@ TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
   ContactKinematics& k = c.kinematics;
   k.deflection_m = deflection;
   k.deflection_rate_m_s = -(SimTK::dot(v_GP, n) - road_->heightRate(c.p_GC[0], c.p_GC[1], s.getTime()));
-  k.vx_m_s = SimTK::dot(v_GW, c.R_GC.x());
-  k.vy_m_s = SimTK::dot(v_GW, c.R_GC.y());
+  k.vx_m_s = SimTK::dot(v_slip, c.R_GC.x());
+  k.vy_m_s = SimTK::dot(v_slip, c.R_GC.y());
   k.spin_rad_s = SimTK::dot(w_GW, s_G);
   k.camber_rad = camber;
   c.forces = model_->calcForces(k);
@@ -102,6 +114,12 @@ TirePlugin::TirePlugin(std::string type, std::string name, std::string wheelBody
   if (!model_) throw Error("tire plugin '" + this->name() + "': no tire model");
 }
 
+TirePlugin& TirePlugin::setSlipCentre(const SimTK::Vec3& slipCentre_W) {
+  if (impl_) throw Error("tire plugin '" + name() + "': set the slip centre before adding it to a scene");
+  slipCentre_W_ = slipCentre_W;
+  return *this;
+}
+
 const TireForceImpl& TirePlugin::getForceElement() const {
   if (!impl_) throw Error("tire plugin '" + name() + "' is not part of a scene yet");
   return *impl_;
@@ -110,7 +128,7 @@ const TireForceImpl& TirePlugin::getForceElement() const {
 void TirePlugin::DoAddTo(Scene& scene) {
   const SimTK::MobilizedBody& wheel = scene.getBody(wheelBody_);
   auto road = scene.getService<const Road>(roadService_);
-  auto* impl = new TireForceImpl(wheel, model_, road, spinAxis_W_, centre_W_);
+  auto* impl = new TireForceImpl(wheel, model_, road, spinAxis_W_, centre_W_, slipCentre_W_.value_or(centre_W_));
   SimTK::Force::Custom(scene.updForces(), impl);  // the subsystem owns impl
   impl_ = impl;
   const TireForceImpl* e = impl;
@@ -132,10 +150,12 @@ void registerTirePlugins(PluginRegistry& registry) {
     registry.add(PluginKind::ForceElement, type, [type](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
       const TireParams p = spec.params.has("params") ? TireParams::fromParams(spec.params.child("params"))
                                                      : TireParams{};
-      return std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"),
+      auto plugin = std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"),
                                           makeTireModel(type, p),
                                           SimTK::UnitVec3(spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0))),
                                           "road", spec.params.vec3Or("centre_m", SimTK::Vec3(0)));
+      if (spec.params.has("slip_centre_m")) plugin->setSlipCentre(spec.params.vec3("slip_centre_m"));
+      return plugin;
     });
   }
 }

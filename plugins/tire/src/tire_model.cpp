@@ -32,6 +32,7 @@ void TireParams::validate(const std::string& w) const {
                 formatValue(mu_max) + ")");
   requireNonNegative(rolling_resistance_coefficient, w + ".rolling_resistance_coefficient");
   requirePositive(low_speed_threshold_m_s, w + ".low_speed_threshold_m_s");
+  requireInRange(rolling_radius_deflection_factor, 0.0, 1.0, w + ".rolling_radius_deflection_factor");
 }
 
 const std::vector<TireParams::Field>& TireParams::fields() {
@@ -47,6 +48,7 @@ const std::vector<TireParams::Field>& TireParams::fields() {
       {"mu_min", &TireParams::mu_min},
       {"rolling_resistance_coefficient", &TireParams::rolling_resistance_coefficient},
       {"low_speed_threshold_m_s", &TireParams::low_speed_threshold_m_s},
+      {"rolling_radius_deflection_factor", &TireParams::rolling_radius_deflection_factor},
   };
   return f;
 }
@@ -77,7 +79,9 @@ double TireModel::calcNormalForce(const ContactKinematics& k) const {
                            p_.radial_damping_N_s_per_m * k.deflection_rate_m_s);
 }
 
-double TireModel::calcRollingRadius(double d) const { return p_.unloaded_radius_m - std::max(0.0, d) / 3.0; }
+double TireModel::calcRollingRadius(double d) const {
+  return p_.unloaded_radius_m - p_.rolling_radius_deflection_factor * std::max(0.0, d);
+}
 
 double TireModel::calcPotentialEnergy(double d) const {
   return d > 0 ? 0.5 * p_.radial_stiffness_N_per_m * d * d : 0.0;

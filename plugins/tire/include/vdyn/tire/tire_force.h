@@ -1,6 +1,7 @@
 #pragma once
 // The tire as a Simbody force element on a wheel body, and its plugin.
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <Simbody.h>
@@ -24,12 +25,18 @@ struct TireContact {
 /// Force::Custom implementation: wheel W (spin axis `spinAxis_W` through the
 /// origin), a torus of radii R1, R2 centred at `centre_W` on the spin axis
 /// (the origin by default; an offset puts two tires on one axle body), against
-/// the road height field.
+/// the road height field. The slip velocities are those of `slipCentre_W` (by
+/// default the tire centre): two tires of a bicycle's axle take the slip of the
+/// axle centre, as the single wheel they stand for would, and carry only their
+/// own normal loads (and so the roll moment) apart.
 class TireForceImpl : public SimTK::Force::Custom::Implementation {
  public:
   TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
                 std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W,
                 const SimTK::Vec3& centre_W = SimTK::Vec3(0));
+  TireForceImpl(const SimTK::MobilizedBody& wheel, std::shared_ptr<const TireModel> model,
+                std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W, const SimTK::Vec3& centre_W,
+                const SimTK::Vec3& slipCentre_W);
 
   /// Needs Stage::Velocity (and Time) realized.
   TireContact calcContact(const SimTK::State& state) const;
@@ -55,7 +62,7 @@ class TireForceImpl : public SimTK::Force::Custom::Implementation {
   std::shared_ptr<const TireModel> model_;
   std::shared_ptr<const Road> road_;
   SimTK::UnitVec3 spinAxis_W_;
-  SimTK::Vec3 centre_W_;
+  SimTK::Vec3 centre_W_, slipCentre_W_;
 };
 
 /// Tire plugin: attaches a TireModel to a named wheel body of the scene, on the
@@ -67,6 +74,8 @@ class TirePlugin : public ForceElementPlugin {
              std::shared_ptr<const TireModel> model,
              SimTK::UnitVec3 spinAxis_W = SimTK::UnitVec3(SimTK::YAxis),
              std::string roadService = "road", SimTK::Vec3 centre_W = SimTK::Vec3(0));
+  /// Slip velocities taken at `slipCentre_W` instead of the tire centre.
+  TirePlugin& setSlipCentre(const SimTK::Vec3& slipCentre_W);
 
   /// Valid after the plugin was added to a scene.
   const TireForceImpl& getForceElement() const;
@@ -82,12 +91,14 @@ class TirePlugin : public ForceElementPlugin {
   SimTK::UnitVec3 spinAxis_W_;
   std::string roadService_;
   SimTK::Vec3 centre_W_;
+  std::optional<SimTK::Vec3> slipCentre_W_;
   const TireForceImpl* impl_ = nullptr;  // owned by the Simbody force subsystem
 };
 
 /// Registers the tire plugins "gim", "fiala" and "linear". Parameters:
 /// {"wheel": "<body name>", "params": {TireParams keys}, "spin_axis": [0, 1, 0],
-///  "centre_m": [0, 0, 0] (tire centre on the wheel body's spin axis, m)}.
+///  "centre_m": [0, 0, 0] (tire centre on the wheel body's spin axis, m),
+///  "slip_centre_m": [0, 0, 0] (where the slip velocities are taken; default the centre)}.
 void registerTirePlugins(PluginRegistry& registry);
 
 }  // namespace vdyn

@@ -28,6 +28,9 @@ struct TireParams {
   double mu_max = 0.80;                         ///< friction coefficient at zero comprehensive slip
   double mu_min = 0.60;                         ///< friction coefficient at full sliding (S = 1)
   double rolling_resistance_coefficient = 0.0;  ///< My = -c Fz Re (against the spin); not in the seed
+  /// Re = R1 - f delta: f = 1/3 is the usual radial-tire approximation; 0 keeps
+  /// Re at R1 (tires sharing one slip, as on the bicycle's axles).
+  double rolling_radius_deflection_factor = 1.0 / 3.0;
   /// Speed below which slip denominators are held at this value, m/s: slips stay
   /// finite at standstill and the tire acts as a stiff damper there.
   double low_speed_threshold_m_s = 0.5;
@@ -72,8 +75,9 @@ class TireModel {
   TireForces calcForces(const ContactKinematics& k) const;
   /// Normal force Fz = max(0, Kz delta + Cz delta'), N.
   double calcNormalForce(const ContactKinematics& k) const;
-  /// Effective rolling radius Re = R1 - delta / 3, m (derived: the usual
-  /// approximation for a radial tire between loaded and unloaded radius).
+  /// Effective rolling radius Re = R1 - f delta, m (f =
+  /// rolling_radius_deflection_factor, 1/3 by default: the usual approximation
+  /// for a radial tire between loaded and unloaded radius).
   double calcRollingRadius(double deflection_m) const;
   /// Elastic energy of the radial spring, Kz delta^2 / 2, J.
   double calcPotentialEnergy(double deflection_m) const;

@@ -1,0 +1,165 @@
+#include "vdyn/vehicles/bicycle.h"
+
+#include "vdyn/plugins/builtin.h"
+#include "vdyn/vehicles/chassis_outputs.h"
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+void BicycleParams::validate() const {
+  chassis.validate("bicycle chassis");
+  front_axle.validate("bicycle front_axle");
+  rear_axle.validate("bicycle rear_axle");
+  fork.validate("bicycle fork");
+  requirePositive(front_track_m, "bicycle front_track_m");
+  requirePositive(rear_track_m, "bicycle rear_track_m");
+  if (!(front_axle_m[0] > rear_axle_m[0]))
+    throw Error("bicycle front axle must lie ahead of the rear axle, got x = " + formatValue(front_axle_m[0]) +
+                " and " + formatValue(rear_axle_m[0]));
+  tire.validate("bicycle tire");
+  makeRoad(road);
+  requireNonNegative(gravity_m_per_s2, "bicycle gravity_m_per_s2");
+}
+
+namespace {
+/// Both corners of an axle lumped into one rigid axle body: mass summed, the
+/// corners' principal inertias summed, plus m (track/2)^2 about x and z for the
+/// two corner masses off the centre line.
+RigidBodyParams lumpAxle(const DoubleWishboneParams& c, double track) {
+  RigidBodyParams b;
+  const double m = c.lower_arm.mass_kg + c.knuckle.mass_kg + c.upper_arm.mass_kg + c.wheel.mass_kg;
+  const Vec3 I = c.lower_arm.inertia_kg_m2 + c.knuckle.inertia_kg_m2 + c.upper_arm.inertia_kg_m2 + c.wheel.inertia_kg_m2;
+  const double off = m * track * track / 4;
+  b.mass_kg = 2 * m;
+  b.inertia_kg_m2 = Vec3(2 * I[0] + 2 * off, 2 * I[1], 2 * I[2] + 2 * off);
+  return b;
+}
+}  // namespace
+
+BicycleParams BicycleParams::fromParams(const ParamReader& r) {
+  BicycleParams p;
+  const ParamReader v = ParamReader::fromFile(r.string("vehicle_data"));
+  p.chassis = RigidBodyParams::fromParams(v.child("chassis"));
+  const DoubleWishboneParams front = DoubleWishboneParams::fromParams(v.child("front_right"));
+  const DoubleWishboneParams rear = DoubleWishboneParams::fromParams(v.child("rear_right"));
+  const Vec3 wf = wheelCentreInChassis(front), wr = wheelCentreInChassis(rear);
+  p.front_axle_m = Vec3(wf[0], 0, wf[2]);
+  p.rear_axle_m = Vec3(wr[0], 0, wr[2]);
+  p.front_track_m = -2 * wf[1];
+  p.rear_track_m = -2 * wr[1];
+  p.front_axle = lumpAxle(front, p.front_track_m);
+  p.rear_axle = lumpAxle(rear, p.rear_track_m);
+  p.fork = RigidBodyParams::fromParams(r.child("fork"));
+  const ParamReader tire = v.child("tire");
+  p.tire_plugin = tire.string("plugin");
+  Json tireParams = tire.child("params").json();
+  if (r.has("tire")) {
+    const ParamReader t = r.child("tire");
+    p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
+    if (t.has("params")) tireParams.merge_patch(t.child("params").json());
+  }
+  p.tire = TireParams::fromParams(ParamReader::fromJson(tireParams, r.where() + " tire.params"));
+  if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
+  p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
+  p.validate();
+  return p;
+}
+
+BicycleParams BicycleParams::fromFile(const std::string& path) { return fromParams(ParamReader::fromFile(path)); }
+
+static SimTK::Body::Rigid rigid(const RigidBodyParams& b) {
+  return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
+}
+
+Bicycle::Bicycle(const BicycleParams& params) : Bicycle(params, builtinPlugins()) {}
+
+Bicycle::Bicycle(const BicycleParams& params, const PluginRegistry& registry)
+    : p_(params), scene_(std::make_unique<Scene>()) {
+  p_.validate();
+  Scene& sc = *scene_;
+  SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
+  chassis_ = SimTK::MobilizedBody::Free(sc.updMatter().Ground(), SimTK::Transform(), rigid(p_.chassis), SimTK::Transform());
+  // Simbody's Pin turns about z: the steer axis is the chassis zeta axis; the
+  // spin axes are eta (a frame rotated so that its z is eta).
+  const SimTK::Rotation R_spin(SimTK::UnitVec3(SimTK::YAxis), SimTK::ZAxis);
+  fork_ = SimTK::MobilizedBody::Pin(chassis_, SimTK::Transform(p_.front_axle_m), rigid(p_.fork), SimTK::Transform());
+  front_ = SimTK::MobilizedBody::Pin(fork_, SimTK::Transform(R_spin), rigid(p_.front_axle), SimTK::Transform(R_spin));
+  rear_ = SimTK::MobilizedBody::Pin(chassis_, SimTK::Transform(R_spin, p_.rear_axle_m), rigid(p_.rear_axle),
+                                    SimTK::Transform(R_spin));
+  sc.addBody("chassis", chassis_);
+  sc.addBody("fork", fork_);
+  sc.addBody("front_axle", front_);
+  sc.addBody("rear_axle", rear_);
+  sc.setService<const Road>("road", makeRoad(p_.road));
+  const Json tireJson = p_.tire.toJson();
+  struct Spec { const char* name; const char* body; double y; };
+  const Spec specs[4] = {{"tire_fr", "front_axle", -p_.front_track_m / 2}, {"tire_fl", "front_axle", p_.front_track_m / 2},
+                         {"tire_rr", "rear_axle", -p_.rear_track_m / 2}, {"tire_rl", "rear_axle", p_.rear_track_m / 2}};
+  for (const Spec& t : specs) {
+    // Both tires of an axle take the slip of the axle centre (see bicycle.h).
+    const Json j{{"params", tireJson}, {"centre_m", {0.0, t.y, 0.0}}, {"slip_centre_m", {0.0, 0.0, 0.0}}};
+    const PluginSpec spec{t.name, ParamReader::fromJson(j, "bicycle tire"), {{"wheel", t.body}}};
+    tires_.push_back(dynamic_cast<const TirePlugin*>(
+        &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire_plugin, spec, "bicycle tire plugin"))));
+    if (!tires_.back()) throw Error("bicycle tire plugin '" + p_.tire_plugin + "' is not a tire plugin");
+  }
+  const auto f = front_, r = rear_;
+  sc.addOutput({"front_axle.spin_rad_s", "rad/s", SimTK::Stage::Velocity, [f](const SimTK::State& s) { return f.getOneU(s, 0); }});
+  sc.addOutput({"rear_axle.spin_rad_s", "rad/s", SimTK::Stage::Velocity, [r](const SimTK::State& s) { return r.getOneU(s, 0); }});
+  addChassisOutputs(sc, chassis_);
+}
+
+const SteeringPlugin& Bicycle::addFrontSteering(const std::string& name, std::shared_ptr<const SteeringCommand> command) {
+  auto plugin = std::make_unique<SteeringPlugin>(name, "chassis", std::vector<std::string>{"fork"}, std::move(command));
+  return static_cast<const SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
+}
+
+double Bicycle::totalMass() const {
+  return p_.chassis.mass_kg + p_.fork.mass_kg + p_.front_axle.mass_kg + p_.rear_axle.mass_kg;
+}
+
+double Bicycle::distanceToFrontAxle() const {
+  const double xc = ((p_.fork.mass_kg + p_.front_axle.mass_kg) * p_.front_axle_m[0] +
+                     p_.rear_axle.mass_kg * p_.rear_axle_m[0]) / totalMass();
+  return p_.front_axle_m[0] - xc;
+}
+
+double Bicycle::distanceToRearAxle() const {
+  return (p_.front_axle_m[0] - p_.rear_axle_m[0]) - distanceToFrontAxle();
+}
+
+int Bicycle::degreesOfFreedom(const SimTK::State& s) const {
+  scene_->getSystem().realize(s, SimTK::Stage::Instance);
+  return s.getNU() - s.getNUDotErr();
+}
+
+SimTK::State Bicycle::makeInitialState(double speed) const {
+  requireFinite(speed, "bicycle initial speed_m_s");
+  const SimTK::MultibodySystem& system = scene_->getSystem();
+  SimTK::State s = scene_->getDefaultState();
+  const double deflection = totalMass() * p_.gravity_m_per_s2 / 4 / p_.tire.radial_stiffness_N_per_m;
+  const double road0 = makeRoad(p_.road)->height(0, 0, 0);
+  const double zAxle = 0.5 * (p_.front_axle_m[2] + p_.rear_axle_m[2]);
+  chassis_.setQToFitTranslation(s, Vec3(0, 0, road0 + p_.tire.unloaded_radius_m - deflection - zAxle));
+  system.realize(s, SimTK::Stage::Position);
+  if (s.getQErr().size() > 0 && s.getQErr().normInf() > 1e-12) {
+    SimTK::Assembler assembler(system);
+    assembler.lockMobilizer(chassis_.getMobilizedBodyIndex());
+    assembler.setErrorTolerance(1e-12);
+    assembler.assemble(s);
+  }
+  s.updU() = 0;
+  chassis_.setUToFitLinearVelocity(s, Vec3(speed, 0, 0));
+  system.realize(s, SimTK::Stage::Velocity);
+  // Free rolling at each axle's own heading speed and rolling radius.
+  const ContactKinematics kf = tires_[0]->calcContact(s).kinematics, kr = tires_[2]->calcContact(s).kinematics;
+  const TireModel& m = tires_[0]->getForceElement().getModel();
+  const double wf = kf.vx_m_s / m.calcRollingRadius(kf.deflection_m), wr = kr.vx_m_s / m.calcRollingRadius(kr.deflection_m);
+  front_.setOneU(s, 0, wf);
+  rear_.setOneU(s, 0, wr);
+  system.realize(s, SimTK::Stage::Velocity);
+  return s;
+}
+
+}  // namespace vdyn
