@@ -180,7 +180,7 @@ TEST(FourWsSteering, CommandErrorsAreNamed) {
     cmd(Json{{"type", "ramp"}});
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "scene.json steering: type: unknown steering command 'ramp'; known: hold, smooth_step");
+    EXPECT_STREQ(e.what(), "scene.json steering: type: unknown steering command 'ramp'; known: hold, smooth_step, steps");
   }
   try {
     cmd(Json{{"type", "smooth_step"}, {"final_rad", 0.1}, {"start_time_s", 0.5}, {"duration_s", -1.0}});

@@ -6,8 +6,8 @@ namespace vdyn {
 
 using SimTK::Vec3;
 
-SteerCommandValue SteeringCommand::calc(const SimTK::State& s) const {
-  const SteerCommandValue v = DoCalc(s.getTime());
+SteerCommandValue SteeringCommand::calcAt(double t) const {
+  const SteerCommandValue v = DoCalc(t);
   assert(std::isfinite(v.angle_rad) && std::isfinite(v.rate_rad_s) && std::isfinite(v.accel_rad_s2));
   return v;
 }
@@ -31,6 +31,28 @@ SteerCommandValue SmoothStepCommand::DoCalc(double t) const {
           D_ / (T_ * T_) * (12 - 48 * s + 36 * s * s)};
 }
 
+StepSequenceCommand::StepSequenceCommand(double d0, std::vector<Step> steps)
+    : d0_(requireInRange(d0, -1.2, 1.2, "steering initial_rad")) {
+  if (steps.empty()) throw Error("steering steps: the sequence is empty");
+  double total = d0;
+  for (const Step& k : steps) {
+    steps_.emplace_back(0.0, k.change_rad, k.start_time_s, k.duration_s);
+    total += k.change_rad;
+  }
+  requireInRange(total, -1.2, 1.2, "steering final angle of the steps");
+}
+
+SteerCommandValue StepSequenceCommand::DoCalc(double t) const {
+  SteerCommandValue v{d0_, 0, 0};
+  for (const auto& k : steps_) {
+    const SteerCommandValue c = k.calcAt(t);
+    v.angle_rad += c.angle_rad;
+    v.rate_rad_s += c.rate_rad_s;
+    v.accel_rad_s2 += c.accel_rad_s2;
+  }
+  return v;
+}
+
 std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r) {
   const std::string type = r.string("type");
   if (type == "hold") return std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
@@ -39,7 +61,13 @@ std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r)
     return std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
                                                r.number("duration_s"));
   }
-  throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step");
+  if (type == "steps") {
+    std::vector<StepSequenceCommand::Step> steps;
+    for (const auto& k : r.array("steps"))
+      steps.push_back({k.number("start_time_s"), k.number("duration_s"), k.number("change_rad")});
+    return std::make_shared<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+  }
+  throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step, steps");
 }
 
 // ---------------------------------------------------------------------------

@@ -32,7 +32,9 @@ struct SteerCommandValue {
 class SteeringCommand {
  public:
   virtual ~SteeringCommand() = default;
-  SteerCommandValue calc(const SimTK::State& s) const;
+  SteerCommandValue calc(const SimTK::State& s) const { return calcAt(s.getTime()); }
+  /// The value at time t_s.
+  SteerCommandValue calcAt(double t_s) const;
 
  protected:
   virtual SteerCommandValue DoCalc(double t_s) const = 0;
@@ -64,8 +66,27 @@ class SmoothStepCommand : public SteeringCommand {
   double d0_, D_, t0_, T_;
 };
 
-/// {"type": "hold", "angle_rad": 0} or {"type": "smooth_step", "initial_rad": 0,
-/// "final_rad": 0.0698, "start_time_s": 0.5, "duration_s": 1.0}.
+/// A sequence of smooth steps (7.4) added together: the open-loop lane change
+/// and circle inputs of the seed's Figure 7.2 (increments dd_k over intervals).
+class StepSequenceCommand : public SteeringCommand {
+ public:
+  struct Step {
+    double start_time_s, duration_s, change_rad;
+  };
+  StepSequenceCommand(double initial_rad, std::vector<Step> steps);
+
+ protected:
+  SteerCommandValue DoCalc(double t) const override;
+
+ private:
+  double d0_;
+  std::vector<SmoothStepCommand> steps_;
+};
+
+/// {"type": "hold", "angle_rad": 0}, {"type": "smooth_step", "initial_rad": 0,
+/// "final_rad": 0.0698, "start_time_s": 0.5, "duration_s": 1.0}, or
+/// {"type": "steps", "initial_rad": 0, "steps": [{"start_time_s": 0.5,
+/// "duration_s": 0.5, "change_rad": 0.035}, ...]}.
 std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r);
 
 /// The constraint of one wheel (Constraint::Custom implementation).
