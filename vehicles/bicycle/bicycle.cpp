@@ -68,10 +68,6 @@ BicycleParams BicycleParams::fromParams(const ParamReader& r) {
 
 BicycleParams BicycleParams::fromFile(const std::string& path) { return fromParams(ParamReader::fromFile(path)); }
 
-static SimTK::Body::Rigid rigid(const RigidBodyParams& b) {
-  return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
-}
-
 Bicycle::Bicycle(const BicycleParams& params) : Bicycle(params, builtinPlugins()) {}
 
 Bicycle::Bicycle(const BicycleParams& params, const PluginRegistry& registry)
@@ -79,13 +75,13 @@ Bicycle::Bicycle(const BicycleParams& params, const PluginRegistry& registry)
   p_.validate();
   Scene& sc = *scene_;
   SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
-  chassis_ = SimTK::MobilizedBody::Free(sc.updMatter().Ground(), SimTK::Transform(), rigid(p_.chassis), SimTK::Transform());
+  chassis_ = SimTK::MobilizedBody::Free(sc.updMatter().Ground(), SimTK::Transform(), makeRigidBody(p_.chassis), SimTK::Transform());
   // Simbody's Pin turns about z: the steer axis is the chassis zeta axis; the
   // spin axes are eta (a frame rotated so that its z is eta).
   const SimTK::Rotation R_spin(SimTK::UnitVec3(SimTK::YAxis), SimTK::ZAxis);
-  fork_ = SimTK::MobilizedBody::Pin(chassis_, SimTK::Transform(p_.front_axle_m), rigid(p_.fork), SimTK::Transform());
-  front_ = SimTK::MobilizedBody::Pin(fork_, SimTK::Transform(R_spin), rigid(p_.front_axle), SimTK::Transform(R_spin));
-  rear_ = SimTK::MobilizedBody::Pin(chassis_, SimTK::Transform(R_spin, p_.rear_axle_m), rigid(p_.rear_axle),
+  fork_ = SimTK::MobilizedBody::Pin(chassis_, SimTK::Transform(p_.front_axle_m), makeRigidBody(p_.fork), SimTK::Transform());
+  front_ = SimTK::MobilizedBody::Pin(fork_, SimTK::Transform(R_spin), makeRigidBody(p_.front_axle), SimTK::Transform(R_spin));
+  rear_ = SimTK::MobilizedBody::Pin(chassis_, SimTK::Transform(R_spin, p_.rear_axle_m), makeRigidBody(p_.rear_axle),
                                     SimTK::Transform(R_spin));
   sc.addBody("chassis", chassis_);
   sc.addBody("fork", fork_);

@@ -116,7 +116,7 @@ Vec3 wheelCentreInChassis(const DoubleWishboneParams& p) {
   return lowerArm + p.lower_ball.parent_point_m - p.lower_ball.child_point_m;
 }
 
-static SimTK::Body::Rigid rigidBody(const RigidBodyParams& b) {
+SimTK::Body::Rigid makeRigidBody(const RigidBodyParams& b) {
   return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
 }
 
@@ -131,13 +131,13 @@ DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& cha
   DoubleWishboneCorner c;
   const SimTK::UnitVec3 a1 = p.lower_pivot.axis(), a4 = p.upper_pivot.axis();
   c.lower_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.lower_pivot.parent_point_m, a1),
-                                          rigidBody(p.lower_arm), pinFrame(p.lower_pivot.child_point_m, a1));
+                                          makeRigidBody(p.lower_arm), pinFrame(p.lower_pivot.child_point_m, a1));
   c.knuckle = SimTK::MobilizedBody::Ball(c.lower_arm, SimTK::Transform(p.lower_ball.parent_point_m),
-                                         rigidBody(p.knuckle), SimTK::Transform(p.lower_ball.child_point_m));
+                                         makeRigidBody(p.knuckle), SimTK::Transform(p.lower_ball.child_point_m));
   c.upper_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.upper_pivot.parent_point_m, a4),
-                                          rigidBody(p.upper_arm), pinFrame(p.upper_pivot.child_point_m, a4));
+                                          makeRigidBody(p.upper_arm), pinFrame(p.upper_pivot.child_point_m, a4));
   const SimTK::UnitVec3 spin(p.wheel_spin_axis);
-  c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), rigidBody(p.wheel),
+  c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), makeRigidBody(p.wheel),
                                       pinFrame(Vec3(0), spin));
   c.upper_ball = SimTK::Constraint::Ball(c.upper_arm, p.upper_ball.parent_point_m, c.knuckle,
                                          p.upper_ball.child_point_m);

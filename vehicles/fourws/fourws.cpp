@@ -50,7 +50,7 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
   SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
   chassis_ = SimTK::MobilizedBody::Free(
       sc.updMatter().Ground(), SimTK::Transform(),
-      SimTK::Body::Rigid(SimTK::MassProperties(p_.chassis.mass_kg, Vec3(0), SimTK::Inertia(p_.chassis.inertia_kg_m2))),
+      makeRigidBody(p_.chassis),
       SimTK::Transform());
   sc.addBody("chassis", chassis_);
   cornerParams_ = {p_.front_right, p_.front_right.mirrored(), p_.rear_right, p_.rear_right.mirrored()};
@@ -112,34 +112,15 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
     bodies.push_back({n + ".upper_arm", corners_[c].upper_arm});
     bodies.push_back({n + ".wheel", corners_[c].wheel});
   }
-  std::vector<Vec3> before;
-  for (const auto& b : bodies) before.push_back(b.second.getBodyOriginLocation(s));
   double gap = 0;
   for (int c = 0; c < 4; ++c) {
     const auto& j = cornerParams_[c].upper_ball;
     gap = std::max(gap, (corners_[c].upper_arm.findStationLocationInGround(s, j.parent_point_m) -
                          corners_[c].knuckle.findStationLocationInGround(s, j.child_point_m)).norm());
   }
-  SimTK::Assembler assembler(system);
-  assembler.lockMobilizer(chassis_.getMobilizedBodyIndex());
-  for (const auto& c : corners_) assembler.lockMobilizer(c.wheel.getMobilizedBodyIndex());
-  assembler.setErrorTolerance(1e-10);
-  try {
-    assembler.assemble(s);
-  } catch (const std::exception& e) {
-    throw Error(std::string("4ws: closing the suspension loops failed: ") + e.what());
-  }
-  system.realize(s, SimTK::Stage::Position);
-  if (report) {
-    report->initial_loop_gap_m = gap;
-    report->body_moves_m.clear();
-    report->max_move_m = 0;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      const double d = (bodies[i].second.getBodyOriginLocation(s) - before[i]).norm();
-      report->body_moves_m.emplace_back(bodies[i].first, d);
-      report->max_move_m = std::max(report->max_move_m, d);
-    }
-  }
+  std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex()};
+  for (const auto& c : corners_) locked.push_back(c.wheel.getMobilizedBodyIndex());
+  assembleLoops(system, s, locked, bodies, gap, "4ws", report);
   // Moving forward with every body at the chassis velocity and the wheels rolling.
   s.updU() = 0;
   chassis_.setUToFitLinearVelocity(s, Vec3(speed, 0, 0));

@@ -160,30 +160,11 @@ SimTK::State QuarterCar::makeInitialState(bool equilibrium, AssemblyReport* repo
   const std::vector<std::pair<std::string, SimTK::MobilizedBody>> bodies = {
       {"lower_arm", corner_.lower_arm}, {"knuckle", corner_.knuckle}, {"upper_arm", corner_.upper_arm},
       {"wheel", corner_.wheel}};
-  std::vector<Vec3> before;
-  for (const auto& b : bodies) before.push_back(b.second.getBodyOriginLocation(s));
-  const double gap = positionConstraintError(s);
-
-  SimTK::Assembler assembler(system);
-  assembler.lockMobilizer(chassis_.getMobilizedBodyIndex());
-  assembler.lockMobilizer(corner_.wheel.getMobilizedBodyIndex());
-  assembler.setErrorTolerance(1e-10);
-  try {
-    assembler.assemble(s);
-  } catch (const std::exception& e) {
-    throw Error(std::string("quarter car: closing the suspension loop failed: ") + e.what());
-  }
-  system.realize(s, SimTK::Stage::Position);
-  if (report) {
-    report->initial_loop_gap_m = gap;
-    report->body_moves_m.clear();
-    report->max_move_m = 0;
-    for (std::size_t i = 0; i < bodies.size(); ++i) {
-      const double d = (bodies[i].second.getBodyOriginLocation(s) - before[i]).norm();
-      report->body_moves_m.emplace_back(bodies[i].first, d);
-      report->max_move_m = std::max(report->max_move_m, d);
-    }
-  }
+  const auto& ub = p_.corner.upper_ball;
+  const double gap = (corner_.upper_arm.findStationLocationInGround(s, ub.parent_point_m) -
+                      corner_.knuckle.findStationLocationInGround(s, ub.child_point_m)).norm();
+  assembleLoops(system, s, {chassis_.getMobilizedBodyIndex(), corner_.wheel.getMobilizedBodyIndex()}, bodies, gap,
+                "quarter car", report);
   if (equilibrium) solveStaticEquilibrium(*scene_, s, ineffectiveMobilizers());
   return s;
 }

@@ -24,6 +24,9 @@ struct RigidBodyParams {
   static RigidBodyParams fromParams(const ParamReader& r);
 };
 
+/// A Simbody rigid body with its centre of mass at the body origin.
+SimTK::Body::Rigid makeRigidBody(const RigidBodyParams& b);
+
 /// A joint between a parent and a child body: a point on each (body frames, m).
 /// For revolute joints a second point on each gives the axis direction.
 struct JointParams {

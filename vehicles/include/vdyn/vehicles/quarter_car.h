@@ -11,6 +11,7 @@
 #include "vdyn/core/scene.h"
 #include "vdyn/tire/road.h"
 #include "vdyn/tire/tire_force.h"
+#include "vdyn/vehicles/assembly.h"
 #include "vdyn/vehicles/double_wishbone.h"
 
 namespace vdyn {
@@ -45,14 +46,6 @@ struct QuarterCarParams {
   /// A copy whose corner.spring_free_length_m puts the tabulated configuration in
   /// static equilibrium (the flag above is then cleared).
   QuarterCarParams withRideHeightSpring() const;
-};
-
-/// How far the bodies moved when the loop was closed from the tabulated
-/// configuration (the App. A positions do not close the loop exactly).
-struct AssemblyReport {
-  std::vector<std::pair<std::string, double>> body_moves_m;  ///< body name -> |displacement of origin|
-  double max_move_m = 0;
-  double initial_loop_gap_m = 0;  ///< |cut-joint point separation| before assembly
 };
 
 class QuarterCar {
