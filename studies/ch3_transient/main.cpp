@@ -57,7 +57,8 @@ int main(int argc, char** argv) {
         "rear_steer.angle_rad", "front_steer.command_rad", "rear_steer.command_rad"};
     // (all at Stage::Velocity or lower: sampling never realizes accelerations)
     Recorder rec(car.getScene(), cols);
-    const RunSummary run = simulate(car.getScene(), s, sim, &rec);
+    const RunSummary run = simulate(car.getScene(), s, sim, &rec, study::progress("ch3_transient", sim.t_end_s));
+    study::endProgress();
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
 

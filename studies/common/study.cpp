@@ -1,6 +1,8 @@
 #include "study.h"
 
+#include <chrono>
 #include <cstdio>
+#include <memory>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
@@ -106,5 +108,21 @@ void plot(const std::vector<PlotSpec>& plots) {
 }
 
 bool interactive() { return isatty(fileno(stderr)); }
+
+std::function<void(const SimTK::State&)> progress(const std::string& label, double tEnd) {
+  if (!interactive()) return {};
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
+  return [label, tEnd, last](const SimTK::State& s) {
+    const auto now = std::chrono::steady_clock::now();
+    if (std::chrono::duration<double>(now - *last).count() < 0.2) return;
+    *last = now;
+    std::fprintf(stderr, "\r%s: t = %.2f / %.2f s", label.c_str(), s.getTime(), tEnd);
+    std::fflush(stderr);
+  };
+}
+
+void endProgress() {
+  if (interactive()) std::fprintf(stderr, "\r\033[K");
+}
 
 }  // namespace vdyn::study

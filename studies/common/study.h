@@ -8,6 +8,7 @@
 #include <vector>
 
 #include <boost/program_options.hpp>
+#include <SimTKcommon.h>
 
 #include "vdyn/core/params.h"
 
@@ -52,5 +53,12 @@ void plot(const std::vector<PlotSpec>& plots);
 
 /// True when stderr is a terminal (progress output is shown only then).
 bool interactive();
+
+/// A step callback for vdyn::simulate that shows "<label>: t = x / t_end s" on
+/// a terminal (at most every 0.2 s of wall time, cleared at the end), or an
+/// empty callback, which costs nothing, when stderr is not a terminal.
+std::function<void(const SimTK::State&)> progress(const std::string& label, double t_end_s);
+/// Clears the progress line (call after the run).
+void endProgress();
 
 }  // namespace vdyn::study

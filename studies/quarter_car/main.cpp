@@ -45,7 +45,8 @@ int main(int argc, char** argv) {
                                               "road.height_m", "suspension.length_m", "wheel.spin_rad_s",
                                               "tire.Fz_N", "tire.Fy_N", "tire.Fx_N", "tire.deflection_m"};
     Recorder rec(car.getScene(), columns);
-    const RunSummary run = simulate(car.getScene(), state, sim, &rec);
+    const RunSummary run = simulate(car.getScene(), state, sim, &rec, study::progress("quarter_car", sim.t_end_s));
+    study::endProgress();
     const double psiValue = car.getScene().getIntegral(psi, state);
 
     const std::string csv = out + "/history.csv";
