@@ -179,3 +179,27 @@ TEST(Simulation, RejectsEndTimeBeforeStart) {
   EXPECT_EQ(errorOf([&] { simulate(car.getScene(), s, sim); }),
             "simulate: t_end_s (-1) must be after the start time 0");
 }
+
+TEST(Simulation, EachRunsCostIntegralStartsAtZero) {
+  // psi over [0, 0.4] equals psi over [0, 0.2] plus that of a second run over
+  // [0.2, 0.4] from where the first ended: the second run's integral starts at
+  // zero (Simbody's Integrator::initialize restarts Measure::Integrate); were it
+  // carried over, [0, 0.2] would be counted twice.
+  QuarterCar car(QuarterCarParams::fromFile("quarter_car.json"));
+  const IntegralHandle h = car.updScene().addIntegralOfSquare("chassis.az_m_s2");
+  SimulationSettings sim;
+  sim.report_interval_s = 0;
+  sim.integrator.accuracy = 1e-9;
+  SimTK::State s = car.makeInitialState();
+  sim.t_end_s = 0.2;
+  simulate(car.getScene(), s, sim);
+  const double first = car.getScene().getIntegral(h, s);
+  sim.t_end_s = 0.4;
+  simulate(car.getScene(), s, sim);
+  const double second = car.getScene().getIntegral(h, s);
+  SimTK::State whole = car.makeInitialState();
+  simulate(car.getScene(), whole, sim);
+  const double total = car.getScene().getIntegral(h, whole);
+  ASSERT_GT(first, 0.0);
+  EXPECT_NEAR(first + second, total, 1e-6 * total);
+}

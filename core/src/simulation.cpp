@@ -16,12 +16,6 @@ double positionConstraintError(const SimTK::State& state) {
   return qerr.size() ? qerr.normInf() : 0.0;
 }
 
-void resetIntegrals(const Scene& scene, SimTK::State& state) {
-  // Integrals live in the force subsystem's z variables and start at zero; the
-  // only z's a Scene allocates are those integrals.
-  scene.getForces().updZ(state) = 0;
-}
-
 RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& s,
                     Recorder* recorder, const std::function<void(const SimTK::State&)>& afterStep) {
   if (!scene.isFinalized())
@@ -31,7 +25,6 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   if (!(s.t_end_s > t0))
     throw Error("simulate: t_end_s (" + formatValue(s.t_end_s) + ") must be after the start time " +
                 formatValue(t0));
-  if (s.reset_integrals) resetIntegrals(scene, state);
 
   RunSummary sum;
   sum.integrator = s.integrator.method;

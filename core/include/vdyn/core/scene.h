@@ -113,7 +113,7 @@ class Scene {
   std::map<std::string, const std::type_info*> serviceTypes_;
   std::vector<std::unique_ptr<Plugin>> plugins_;
   std::map<std::string, Output> outputs_;
-  std::vector<SimTK::Measure> integrals_;
+  std::vector<SimTK::Measure::Integrate> integrals_;
   mutable SimTK::State defaultState_;
   mutable bool finalized_ = false;
 };

@@ -15,8 +15,6 @@ struct SimulationSettings {
   /// Interval between recorder samples, s; samples are interpolated, never forced steps.
   double report_interval_s = 0.01;
   IntegratorSettings integrator;
-  /// Reset every integral requested with Scene::addIntegralOfSquare to 0 at the start.
-  bool reset_integrals = true;
 
   void validate() const;
 };
@@ -38,15 +36,14 @@ struct RunSummary {
 /// Largest position-constraint error of a state realized through Position.
 double positionConstraintError(const SimTK::State& state);
 
-/// Advances `state` (initial in, final out) to settings.t_end_s. If `recorder`
+/// Advances `state` (initial in, final out) to settings.t_end_s. Every cost
+/// integral (Scene::addIntegralOfSquare) starts the run at zero: Simbody's
+/// Integrator::initialize restarts each Measure::Integrate from its initial value. If `recorder`
 /// is given it samples at the start and every report interval. `afterStep` is
 /// called with the advanced state after every accepted step. Integration
 /// failures are rethrown as Error naming the time and the integrator.
 RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& settings,
                     Recorder* recorder = nullptr,
                     const std::function<void(const SimTK::State&)>& afterStep = {});
-
-/// Sets every integral requested with Scene::addIntegralOfSquare to zero.
-void resetIntegrals(const Scene& scene, SimTK::State& state);
 
 }  // namespace vdyn
