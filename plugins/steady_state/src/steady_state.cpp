@@ -292,7 +292,7 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
   };
   const bool debug = std::getenv("VDYN_DEBUG_STEADY") != nullptr;
   bool fresh = false;  // J_ was computed at the current x
-  if (!haveJacobian_ || !opt_.broyden) {
+  if (!haveJacobian_ || !opt_.broyden || opt_.fresh_jacobian_each_solve) {
     calcJacobian(x, r, J_);
     ++res.jacobians;
     haveJacobian_ = fresh = true;
@@ -546,27 +546,42 @@ std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, cons
                                                  const std::vector<double>& values,
                                                  const std::function<void(SimTK::State&, double)>& setCondition) {
   std::vector<ContinuationPoint> out;
-  int last = -1, before = -1;  // the two latest converged points
+  std::vector<int> done;  // converged points, latest last
   for (double v : values) {
     ContinuationPoint p;
     p.value = v;
     try {
-      if (last < 0) {
+      if (done.empty()) {
         SimTK::State s = start;
         setCondition(s, v);
         p.result = solver.solve(s);
       } else {
-        SteadyStateResult guess = out[last].result;
+        SteadyStateResult guess = out[done.back()].result;
         setCondition(guess.euler_state, v);
-        const double v1 = out[last].value;
-        if (before >= 0 && out[before].value != v1) {
-          // Secant predictor along the branch, in the solver's unknowns.
-          const double t = (v - v1) / (v1 - out[before].value);
-          const SteadyStateResult& r1 = out[last].result;
-          const SteadyStateResult& r0 = out[before].result;
-          const Eigen::VectorXd x1 = solver.getUnknowns(r1.euler_state, r1.multipliers);
-          const Eigen::VectorXd xp = x1 + t * (x1 - solver.getUnknowns(r0.euler_state, r0.multipliers));
-          solver.setGuess(xp, guess);
+        // Predictor: Lagrange extrapolation through the last (up to three)
+        // converged points along the branch, in the solver's unknowns.
+        const std::size_t k = std::min<std::size_t>(3, done.size());
+        if (k >= 2) {
+          std::vector<double> vs;
+          std::vector<Eigen::VectorXd> xs;
+          for (std::size_t i = done.size() - k; i < done.size(); ++i) {
+            const SteadyStateResult& r = out[done[i]].result;
+            vs.push_back(out[done[i]].value);
+            xs.push_back(solver.getUnknowns(r.euler_state, r.multipliers));
+          }
+          bool distinct = true;
+          for (std::size_t i = 0; i < k; ++i)
+            for (std::size_t j = i + 1; j < k; ++j) distinct &= vs[i] != vs[j];
+          if (distinct) {
+            Eigen::VectorXd xp = Eigen::VectorXd::Zero(xs[0].size());
+            for (std::size_t i = 0; i < k; ++i) {
+              double w = 1;
+              for (std::size_t j = 0; j < k; ++j)
+                if (j != i) w *= (v - vs[j]) / (vs[i] - vs[j]);
+              xp += w * xs[i];
+            }
+            solver.setGuess(xp, guess);
+          }
         }
         p.result = solver.resolve(guess);
       }
@@ -575,10 +590,7 @@ std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, cons
       p.failure = e.what();
     }
     out.push_back(std::move(p));
-    if (out.back().converged) {
-      before = last;
-      last = int(out.size()) - 1;
-    }
+    if (out.back().converged) done.push_back(int(out.size()) - 1);
   }
   return out;
 }
