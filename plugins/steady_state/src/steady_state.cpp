@@ -544,53 +544,79 @@ StabilityResult SteadyStateSolver::calcStability(const SteadyStateResult& steady
 // --- continuation and sensitivity ------------------------------------------------
 std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, const SimTK::State& start,
                                                  const std::vector<double>& values,
-                                                 const std::function<void(SimTK::State&, double)>& setCondition) {
+                                                 const std::function<void(SimTK::State&, double)>& setCondition,
+                                                 const ContinuationOptions& options) {
   std::vector<ContinuationPoint> out;
-  std::vector<int> done;  // converged points, latest last
+  // Converged points along the branch (values and solutions), latest last;
+  // intermediate points of a bisected step are kept here but not reported.
+  std::vector<std::pair<double, SteadyStateResult>> branch;
+  auto predict = [&](double v, SteadyStateResult& guess) {
+    // Lagrange extrapolation through the last (up to three) branch points.
+    const std::size_t k = std::min<std::size_t>(3, branch.size());
+    if (k < 2) return;
+    std::vector<double> vs;
+    std::vector<Eigen::VectorXd> xs;
+    for (std::size_t i = branch.size() - k; i < branch.size(); ++i) {
+      vs.push_back(branch[i].first);
+      xs.push_back(solver.getUnknowns(branch[i].second.euler_state, branch[i].second.multipliers));
+    }
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = i + 1; j < k; ++j)
+        if (vs[i] == vs[j]) return;
+    Eigen::VectorXd xp = Eigen::VectorXd::Zero(xs[0].size());
+    for (std::size_t i = 0; i < k; ++i) {
+      double w = 1;
+      for (std::size_t j = 0; j < k; ++j)
+        if (j != i) w *= (v - vs[j]) / (vs[i] - vs[j]);
+      xp += w * xs[i];
+    }
+    solver.setGuess(xp, guess);
+  };
+  auto solveAt = [&](double v) {
+    if (branch.empty()) {
+      SimTK::State s = start;
+      setCondition(s, v);
+      return solver.solve(s);
+    }
+    SteadyStateResult guess = branch.back().second;
+    setCondition(guess.euler_state, v);
+    predict(v, guess);
+    return solver.resolve(guess);
+  };
+  bool ended = false;
   for (double v : values) {
     ContinuationPoint p;
     p.value = v;
-    try {
-      if (done.empty()) {
-        SimTK::State s = start;
-        setCondition(s, v);
-        p.result = solver.solve(s);
-      } else {
-        SteadyStateResult guess = out[done.back()].result;
-        setCondition(guess.euler_state, v);
-        // Predictor: Lagrange extrapolation through the last (up to three)
-        // converged points along the branch, in the solver's unknowns.
-        const std::size_t k = std::min<std::size_t>(3, done.size());
-        if (k >= 2) {
-          std::vector<double> vs;
-          std::vector<Eigen::VectorXd> xs;
-          for (std::size_t i = done.size() - k; i < done.size(); ++i) {
-            const SteadyStateResult& r = out[done[i]].result;
-            vs.push_back(out[done[i]].value);
-            xs.push_back(solver.getUnknowns(r.euler_state, r.multipliers));
-          }
-          bool distinct = true;
-          for (std::size_t i = 0; i < k; ++i)
-            for (std::size_t j = i + 1; j < k; ++j) distinct &= vs[i] != vs[j];
-          if (distinct) {
-            Eigen::VectorXd xp = Eigen::VectorXd::Zero(xs[0].size());
-            for (std::size_t i = 0; i < k; ++i) {
-              double w = 1;
-              for (std::size_t j = 0; j < k; ++j)
-                if (j != i) w *= (v - vs[j]) / (vs[i] - vs[j]);
-              xp += w * xs[i];
-            }
-            solver.setGuess(xp, guess);
-          }
-        }
-        p.result = solver.resolve(guess);
-      }
-      p.converged = true;
-    } catch (const Error& e) {
-      p.failure = e.what();
+    if (ended) {
+      p.failure = "the branch ended before this value (no steady state found by continuation)";
+      out.push_back(std::move(p));
+      continue;
     }
+    // Try the full step; on failure, reach v by halving the step from the
+    // last converged point, up to max_bisections times.
+    double target = v;
+    int halvings = 0;
+    while (true) {
+      try {
+        SteadyStateResult r = solveAt(target);
+        branch.emplace_back(target, r);
+        if (target == v) {
+          p.result = std::move(r);
+          p.converged = true;
+          break;
+        }
+        target = v;  // an intermediate point converged: try the rest
+      } catch (const Error& e) {
+        if (branch.empty() || halvings == options.max_bisections) {
+          p.failure = e.what();
+          break;
+        }
+        ++halvings;
+        target = branch.back().first + 0.5 * (target - branch.back().first);
+      }
+    }
+    if (!p.converged && options.stop_at_branch_end && !branch.empty()) ended = true;
     out.push_back(std::move(p));
-    if (out.back().converged) done.push_back(int(out.size()) - 1);
   }
   return out;
 }

@@ -169,14 +169,24 @@ struct ContinuationPoint {
   SteadyStateResult result;   ///< valid when converged
 };
 
+struct ContinuationOptions {
+  /// A failed step is retried as up to this many halvings from the last
+  /// converged point before the point is declared without a steady state.
+  int max_bisections = 4;
+  /// After a point fails, report the remaining values as beyond the branch's
+  /// end instead of solving them from a distant start (which can land on
+  /// another, unrelated branch).
+  bool stop_at_branch_end = true;
+};
+
 /// Follows the steady state as a driving condition takes `values` in turn:
 /// `setCondition(state, value)` applies it (e.g. a speed, a steering angle);
 /// each solve starts from the previous solutions extrapolated along the branch
-/// (linear through two, quadratic through three converged points). A point that fails is
-/// reported, and the next one starts again from the last converged point.
+/// (linear through two, quadratic through three converged points).
 std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, const SimTK::State& start,
                                                  const std::vector<double>& values,
-                                                 const std::function<void(SimTK::State&, double)>& setCondition);
+                                                 const std::function<void(SimTK::State&, double)>& setCondition,
+                                                 const ContinuationOptions& options = {});
 
 /// Steady-state sensitivity (4.47)-(4.49): d outputs / d p by central
 /// differences of converged solutions at p0 +- h. With no h given, h =
