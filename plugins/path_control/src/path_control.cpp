@@ -1,0 +1,159 @@
+#include "vdyn/path_control/path_control.h"
+
+#include <cmath>
+
+namespace vdyn {
+
+using SimTK::Vec2;
+using SimTK::Vec3;
+
+void PathControlParams::validate() const {
+  requireNonNegative(k1_rad_per_s2_per_m, "path control k1_rad_per_s2_per_m");
+  requireNonNegative(k2_rad_per_s2, "path control k2_rad_per_s2");
+  requireNonNegative(k3_rad_per_s2_per_m, "path control k3_rad_per_s2_per_m");
+  requireNonNegative(k4_rad_per_s2, "path control k4_rad_per_s2");
+  requireNonNegative(k5_per_s, "path control k5_per_s");
+  requireNonNegative(look_ahead_s, "path control look_ahead_s");
+  requirePositive(acceleration_lag_s, "path control acceleration_lag_s");
+}
+
+PathControlParams PathControlParams::fromParams(const ParamReader& r) {
+  PathControlParams p;
+  p.k1_rad_per_s2_per_m = r.number("k1_rad_per_s2_per_m");
+  p.k2_rad_per_s2 = r.number("k2_rad_per_s2");
+  p.k3_rad_per_s2_per_m = r.number("k3_rad_per_s2_per_m");
+  p.k4_rad_per_s2 = r.number("k4_rad_per_s2");
+  p.k5_per_s = r.number("k5_per_s");
+  p.look_ahead_s = r.number("look_ahead_s");
+  p.predict_with_acceleration = r.booleanOr("predict_with_acceleration", p.predict_with_acceleration);
+  p.acceleration_lag_s = r.numberOr("acceleration_lag_s", p.acceleration_lag_s);
+  p.validate();
+  return p;
+}
+
+// ---------------------------------------------------------------------------
+PathController::PathController(std::string name, const PathControlParams& params,
+                               std::shared_ptr<const ReferencePath> path, const SimTK::MobilizedBody& chassis,
+                               const SimTK::MobilizedBody::Pin& steer, SimTK::Measure ax, SimTK::Measure ay)
+    : SteeringLaw(std::move(name)), p_(params), path_(std::move(path)), chassis_(chassis), steer_(steer), ax_(ax),
+      ay_(ay) {
+  p_.validate();
+  if (!path_) throw Error("path controller '" + this->name() + "': no path");
+  assert(!p_.predict_with_acceleration || (!ax_.isEmptyHandle() && !ay_.isEmptyHandle()));
+}
+
+PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) const {
+  PathControlEvaluation e;
+  const Vec3 p = chassis_.getBodyOriginLocation(s), v = chassis_.getBodyOriginVelocity(s);
+  e.p_G = Vec2(p[0], p[1]);
+  e.v_G = Vec2(v[0], v[1]);
+  e.a_G = p_.predict_with_acceleration ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0);
+  const double dT = p_.look_ahead_s;
+  e.p_ahead_G = e.p_G + e.v_G * dT + e.a_G * (dT * dT / 2);  // (7.13)-(7.14)
+  e.v_ahead_G = e.v_G + e.a_G * dT;                           // (7.15)-(7.16)
+  e.now = path_->calcErrors(e.p_G, e.v_G);                    // e1, e2 (7.9)-(7.10), (7.19)-(7.21)
+  e.ahead = path_->calcErrors(e.p_ahead_G, e.v_ahead_G);      // e3, e4
+  e.steer_rate_rad_s = steer_.getRate(s);
+  // (7.17) with the artificial damper (7.18).
+  e.accel_rad_s2 = -(p_.k1_rad_per_s2_per_m * e.now.position_m + p_.k2_rad_per_s2 * e.now.slope +
+                     p_.k3_rad_per_s2_per_m * e.ahead.position_m + p_.k4_rad_per_s2 * e.ahead.slope) -
+                   p_.k5_per_s * e.steer_rate_rad_s;
+  return e;
+}
+
+// ---------------------------------------------------------------------------
+namespace {
+/// (x'' - a) / tau for one horizontal component of the chassis acceleration:
+/// the derivative of the lag state a. Depends on Stage::Acceleration (Simbody
+/// realizes the matter subsystem's accelerations before the force subsystem's
+/// measures, so the z derivative can read them).
+class LagRateMeasure : public SimTK::Measure_<SimTK::Real> {
+ public:
+  class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
+   public:
+    Implementation(const SimTK::MobilizedBody& body, int axis, double tau)
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 1), body_(body), axis_(axis), tau_(tau) {}
+    Implementation* cloneVirtual() const override { return new Implementation(*this); }
+    int getNumTimeDerivativesVirtual() const override { return 0; }
+    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Acceleration; }
+    void calcCachedValueVirtual(const SimTK::State& s, int, SimTK::Real& value) const override {
+      value = (body_.getBodyOriginAcceleration(s)[axis_] - lagged_.getValue(s)) / tau_;
+    }
+    SimTK::Measure lagged_;  // the integral this is the derivative of (set after construction)
+
+   private:
+    SimTK::MobilizedBody body_;
+    int axis_;
+    double tau_;
+  };
+  LagRateMeasure(SimTK::Subsystem& sub, Implementation* impl)
+      : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
+};
+
+SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, int axis, double tau) {
+  SimTK::Subsystem& sub = scene.updForces();
+  SimTK::Measure::Integrate lagged(sub, SimTK::Measure::Zero(sub), SimTK::Measure::Zero(sub));
+  auto* impl = new LagRateMeasure::Implementation(chassis, axis, tau);
+  impl->lagged_ = lagged;
+  LagRateMeasure rate(sub, impl);
+  lagged.setDerivativeMeasure(rate);
+  return lagged;
+}
+}  // namespace
+
+PathControlPlugin::PathControlPlugin(std::string name, std::string steeringPlugin, std::string chassisBody,
+                                     std::shared_ptr<const ReferencePath> path, const PathControlParams& params)
+    : ControllerPlugin("path_control", std::move(name)),
+      steering_(std::move(steeringPlugin)),
+      chassis_(std::move(chassisBody)),
+      path_(std::move(path)),
+      p_(params) {
+  p_.validate();
+  if (!path_) throw Error("path control plugin '" + this->name() + "': no path");
+}
+
+const PathController& PathControlPlugin::controller() const {
+  if (!law_) throw Error("path control plugin '" + name() + "' is not added to a scene yet");
+  return *law_;
+}
+
+void PathControlPlugin::DoAddTo(Scene& scene) {
+  auto* steer = scene.findPlugin<SteeringPlugin>(steering_);
+  if (!steer) throw Error("path control plugin '" + name() + "': the scene has no steering plugin '" + steering_ + "'");
+  if (!steer->isStateDriven())
+    throw Error("path control plugin '" + name() + "': steering plugin '" + steering_ +
+                "' follows a time command; the controller needs a state-driven one");
+  const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
+  SimTK::Measure ax, ay;
+  if (p_.predict_with_acceleration) {
+    ax = addLaggedAcceleration(scene, chassis, 0, p_.acceleration_lag_s);
+    ay = addLaggedAcceleration(scene, chassis, 1, p_.acceleration_lag_s);
+  }
+  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, steer->getSteerBody(), ax, ay);
+  steer->setAccelerationLaw(law_);
+  const auto law = law_;
+  auto add = [&](const std::string& key, const std::string& unit, auto f) {
+    scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity,
+                     [law, f](const SimTK::State& s) { return f(law->calcEvaluation(s)); }});
+  };
+  add("e1_m", "m", [](const PathControlEvaluation& e) { return e.now.position_m; });
+  add("e2", "1", [](const PathControlEvaluation& e) { return e.now.slope; });
+  add("e3_m", "m", [](const PathControlEvaluation& e) { return e.ahead.position_m; });
+  add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
+  const auto path = path_;
+  const SimTK::MobilizedBody ch = chassis;
+  scene.addOutput({name() + ".path_distance_m", "m", SimTK::Stage::Position, [path, ch](const SimTK::State& s) {
+                     const Vec3 p = ch.getBodyOriginLocation(s);
+                     return path->calcDistance(Vec2(p[0], p[1]));
+                   }});
+}
+
+void registerPathControlPlugins(PluginRegistry& registry) {
+  registry.add(PluginKind::Controller, "path_control", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+    return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"),
+                                               makeReferencePath(spec.params.child("path")),
+                                               PathControlParams::fromParams(spec.params.child("gains")));
+  });
+}
+
+}  // namespace vdyn
