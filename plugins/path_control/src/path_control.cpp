@@ -15,6 +15,10 @@ void PathControlParams::validate() const {
   requireNonNegative(k5_per_s, "path control k5_per_s");
   requireNonNegative(look_ahead_s, "path control look_ahead_s");
   requirePositive(acceleration_lag_s, "path control acceleration_lag_s");
+  for (int i = 0; i < 3; ++i) requireFinite(tracked_point_m[i], "path control tracked_point_m");
+  if (acceleration_estimate != "lagged" && acceleration_estimate != "none")
+    throw Error("path control acceleration_estimate must be \"lagged\" or \"none\", got \"" +
+                acceleration_estimate + "\"");
 }
 
 PathControlParams PathControlParams::fromParams(const ParamReader& r) {
@@ -25,8 +29,9 @@ PathControlParams PathControlParams::fromParams(const ParamReader& r) {
   p.k4_rad_per_s2 = r.number("k4_rad_per_s2");
   p.k5_per_s = r.number("k5_per_s");
   p.look_ahead_s = r.number("look_ahead_s");
-  p.predict_with_acceleration = r.booleanOr("predict_with_acceleration", p.predict_with_acceleration);
+  p.acceleration_estimate = r.stringOr("acceleration_estimate", p.acceleration_estimate);
   p.acceleration_lag_s = r.numberOr("acceleration_lag_s", p.acceleration_lag_s);
+  p.tracked_point_m = r.vec3Or("tracked_point_m", p.tracked_point_m);
   p.validate();
   return p;
 }
@@ -39,15 +44,17 @@ PathController::PathController(std::string name, const PathControlParams& params
       ay_(ay) {
   p_.validate();
   if (!path_) throw Error("path controller '" + this->name() + "': no path");
-  assert(!p_.predict_with_acceleration || (!ax_.isEmptyHandle() && !ay_.isEmptyHandle()));
+  assert(p_.acceleration_estimate != "lagged" || (!ax_.isEmptyHandle() && !ay_.isEmptyHandle()));
+  lagged_ = p_.acceleration_estimate == "lagged";
 }
 
 PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) const {
   PathControlEvaluation e;
-  const Vec3 p = chassis_.getBodyOriginLocation(s), v = chassis_.getBodyOriginVelocity(s);
+  const Vec3 p = chassis_.findStationLocationInGround(s, p_.tracked_point_m),
+             v = chassis_.findStationVelocityInGround(s, p_.tracked_point_m);
   e.p_G = Vec2(p[0], p[1]);
   e.v_G = Vec2(v[0], v[1]);
-  e.a_G = p_.predict_with_acceleration ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0);
+  e.a_G = lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0);
   const double dT = p_.look_ahead_s;
   e.p_ahead_G = e.p_G + e.v_G * dT + e.a_G * (dT * dT / 2);  // (7.13)-(7.14)
   e.v_ahead_G = e.v_G + e.a_G * dT;                           // (7.15)-(7.16)
@@ -63,41 +70,49 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
 
 // ---------------------------------------------------------------------------
 namespace {
-/// (x'' - a) / tau for one horizontal component of the chassis acceleration:
-/// the derivative of the lag state a. Depends on Stage::Acceleration (Simbody
-/// realizes the matter subsystem's accelerations before the force subsystem's
-/// measures, so the z derivative can read them).
-class LagRateMeasure : public SimTK::Measure_<SimTK::Real> {
+/// One horizontal component a of the tracked point's acceleration through a
+/// first-order lag: a z variable with a' = (x'' - a) / tau. Its value is read
+/// from z directly (no cache entry: z can change without Stage::Time being
+/// invalidated). The derivative is set while the force subsystem realizes
+/// Acceleration, after Simbody has computed the matter's accelerations.
+class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
  public:
   class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
    public:
-    Implementation(const SimTK::MobilizedBody& body, int axis, double tau)
-        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 1), body_(body), axis_(axis), tau_(tau) {}
+    Implementation(const SimTK::MobilizedBody& body, const Vec3& station, int axis, double tau)
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0), body_(body), station_(station), axis_(axis), tau_(tau) {}
     Implementation* cloneVirtual() const override { return new Implementation(*this); }
     int getNumTimeDerivativesVirtual() const override { return 0; }
-    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Acceleration; }
-    void calcCachedValueVirtual(const SimTK::State& s, int, SimTK::Real& value) const override {
-      value = (body_.getBodyOriginAcceleration(s)[axis_] - lagged_.getValue(s)) / tau_;
+    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
+    const SimTK::Real& getUncachedValueVirtual(const SimTK::State& s, int derivOrder) const override {
+      assert(derivOrder == 0);
+      (void)derivOrder;
+      return getSubsystem().getZ(s)[zIndex_];
     }
-    SimTK::Measure lagged_;  // the integral this is the derivative of (set after construction)
+    void realizeMeasureTopologyVirtual(SimTK::State& s) const override {
+      zIndex_ = getSubsystem().allocateZ(s, SimTK::Vector(1, 0.0));
+    }
+    void initializeVirtual(SimTK::State& s) const override { getSubsystem().updZ(s)[zIndex_] = 0; }
+    void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
+      const double a = body_.findStationAccelerationInGround(s, station_)[axis_];
+      getSubsystem().updZDot(s)[zIndex_] = (a - getSubsystem().getZ(s)[zIndex_]) / tau_;
+    }
 
    private:
     SimTK::MobilizedBody body_;
+    Vec3 station_;
     int axis_;
     double tau_;
+    mutable SimTK::ZIndex zIndex_;
   };
-  LagRateMeasure(SimTK::Subsystem& sub, Implementation* impl)
+  LaggedAccelerationMeasure(SimTK::Subsystem& sub, Implementation* impl)
       : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
 };
 
-SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, int axis, double tau) {
-  SimTK::Subsystem& sub = scene.updForces();
-  SimTK::Measure::Integrate lagged(sub, SimTK::Measure::Zero(sub), SimTK::Measure::Zero(sub));
-  auto* impl = new LagRateMeasure::Implementation(chassis, axis, tau);
-  impl->lagged_ = lagged;
-  LagRateMeasure rate(sub, impl);
-  lagged.setDerivativeMeasure(rate);
-  return lagged;
+SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, const Vec3& station, int axis,
+                                     double tau) {
+  return LaggedAccelerationMeasure(scene.updForces(),
+                                   new LaggedAccelerationMeasure::Implementation(chassis, station, axis, tau));
 }
 }  // namespace
 
@@ -125,9 +140,9 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
                 "' follows a time command; the controller needs a state-driven one");
   const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
   SimTK::Measure ax, ay;
-  if (p_.predict_with_acceleration) {
-    ax = addLaggedAcceleration(scene, chassis, 0, p_.acceleration_lag_s);
-    ay = addLaggedAcceleration(scene, chassis, 1, p_.acceleration_lag_s);
+  if (p_.acceleration_estimate == "lagged") {
+    ax = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 0, p_.acceleration_lag_s);
+    ay = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 1, p_.acceleration_lag_s);
   }
   law_ = std::make_shared<PathController>(name(), p_, path_, chassis, steer->getSteerBody(), ax, ay);
   steer->setAccelerationLaw(law_);
@@ -142,8 +157,9 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
   const auto path = path_;
   const SimTK::MobilizedBody ch = chassis;
-  scene.addOutput({name() + ".path_distance_m", "m", SimTK::Stage::Position, [path, ch](const SimTK::State& s) {
-                     const Vec3 p = ch.getBodyOriginLocation(s);
+  const Vec3 station = p_.tracked_point_m;
+  scene.addOutput({name() + ".path_distance_m", "m", SimTK::Stage::Position, [path, ch, station](const SimTK::State& s) {
+                     const Vec3 p = ch.findStationLocationInGround(s, station);
                      return path->calcDistance(Vec2(p[0], p[1]));
                    }});
 }

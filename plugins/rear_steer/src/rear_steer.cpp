@@ -34,9 +34,9 @@ double LinearBicycleParams::calcKr(double U) const {
 
 // ---------------------------------------------------------------------------
 void KrTable::validate(const std::string& where) const {
-  if (rows.empty()) throw Error(where + ": fit: the table has no rows");
+  if (rows.empty()) throw Error(where + ": the table has no rows");
   for (std::size_t i = 0; i < rows.size(); ++i) {
-    const std::string at = where + ": fit[" + std::to_string(i) + "]";
+    const std::string at = where + "[" + std::to_string(i) + "]";
     requireNonNegative(rows[i].speed_m_s, at + ".speed_m_s");
     requireFinite(rows[i].c1, at + ".c1");
     requireFinite(rows[i].c2_per_deg2, at + ".c2_per_deg2");
@@ -52,7 +52,7 @@ KrTable KrTable::fromParams(const ParamReader& r) {
   KrTable t;
   for (const auto& row : r.array("fit"))
     t.rows.push_back({row.number("speed_m_s"), row.number("c1"), row.number("c2_per_deg2")});
-  t.validate(r.where());
+  t.validate(r.at("fit"));
   return t;
 }
 
@@ -87,7 +87,7 @@ RearSteerTarget LinearKrStrategy::DoCalcTarget(double U, double df, double dfd, 
 }
 
 NonlinearKrStrategy::NonlinearKrStrategy(KrTable table) : table_(std::move(table)) {
-  table_.validate("nonlinear rear steer table");
+  table_.validate("nonlinear rear steer table fit");
 }
 
 RearSteerTarget NonlinearKrStrategy::DoCalcTarget(double U, double df, double dfd, double dfdd) const {

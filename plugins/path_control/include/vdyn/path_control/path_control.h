@@ -9,11 +9,17 @@
 // The errors and their signs are the path's (vdyn/path/path.h: > 0 left of
 // the path), so positive gains steer back toward it.
 //
-// The chassis acceleration x'' of (7.13)-(7.16) cannot enter a law that sets
-// delta'' directly (x'' depends on delta''). The seed assumes the acceleration
-// changes smoothly; here it enters through a first-order lag of time constant
-// tau (two z variables, a' = (x'' - a) / tau, integrated with error control),
-// a stated choice; predict_with_acceleration = false drops it.
+// The chassis acceleration x'' of (7.13)-(7.16) cannot be the one Simbody
+// computes from this very law (x'' depends on delta''). The seed assumes it
+// changes smoothly; here the measured acceleration of the tracked point
+// enters through a first-order lag of time constant tau (two z variables,
+// a' = (x'' - a) / tau, integrated with error control), a stated choice
+// (acceleration_estimate "lagged"; "none" drops x''). The term matters: the
+// tire force answers a steering change at once, so x'' puts a term
+// proportional to delta into (7.17) and damps the fast loop
+// delta -> tire force -> e3 -> delta''. Estimating x'' from the yaw rate,
+// r (-y', x'), loses that term, and the seed's gains then oscillate (measured
+// on the bicycle); so does a lag tau of 0.02 s or more.
 #include <memory>
 #include <string>
 
@@ -34,24 +40,29 @@ struct PathControlParams {
   double k4_rad_per_s2 = 5;         ///< K4, on e4 (slope at t + dT), rad/s^2 per unit slope (J-turn: per rad)
   double k5_per_s = 10;             ///< K5, the artificial damper on delta' (7.18), 1/s
   double look_ahead_s = 0.6;        ///< dT of (7.13)-(7.16), s (>= 0)
-  bool predict_with_acceleration = true;  ///< use x'' in (7.13)-(7.16)
-  /// tau of the lag on x'' (see above), s (> 0). The x'' term closes a fast
-  /// loop (delta -> front tire force -> x'' -> e3 -> delta''); its lag must
-  /// stay well below that loop's period: on the bicycle at 10 m/s, tau = 0.02 s
-  /// already excites it (36 deg steering peaks) and 0.05 s diverges.
+  /// x'' in (7.13)-(7.16): "lagged" or "none" (see above).
+  std::string acceleration_estimate = "lagged";
+  /// tau of the "lagged" estimate, s (> 0). It must stay well below the fast
+  /// loop's period: on the bicycle at 10 m/s, 0.02 s already excites it (36 deg
+  /// steering peaks) and 0.05 s diverges.
   double acceleration_lag_s = 0.003;
+  /// The chassis point that follows the path, in the chassis frame, m (the
+  /// seed: the centre of mass, [0, 0, 0]). A point at ground level keeps the
+  /// chassis roll out of the errors (the bicycle's roll on its tires alone is
+  /// a lightly damped 3.5 Hz mode that the c.m. would feed back).
+  SimTK::Vec3 tracked_point_m{0, 0, 0};
 
   void validate() const;
   /// Keys k1_rad_per_s2_per_m, k2_rad_per_s2, k3_rad_per_s2_per_m,
   /// k4_rad_per_s2, k5_per_s, look_ahead_s (all required), and optional
-  /// predict_with_acceleration, acceleration_lag_s.
+  /// acceleration_estimate, acceleration_lag_s, tracked_point_m.
   static PathControlParams fromParams(const ParamReader& r);
 };
 
 /// What the controller sees on a state (Stage::Velocity).
 struct PathControlEvaluation {
-  SimTK::Vec2 p_G, v_G, a_G;            ///< chassis c.m. position, velocity, (lagged) acceleration
-  SimTK::Vec2 p_ahead_G, v_ahead_G;     ///< predicted at t + dT (7.13)-(7.16)
+  SimTK::Vec2 p_G{0, 0}, v_G{0, 0}, a_G{0, 0};  ///< tracked point's position, velocity, estimated acceleration
+  SimTK::Vec2 p_ahead_G{0, 0}, v_ahead_G{0, 0}; ///< predicted at t + dT (7.13)-(7.16)
   PathErrors now, ahead;                ///< (e1, e2) and (e3, e4)
   double steer_rate_rad_s = 0;          ///< delta'
   double accel_rad_s2 = 0;              ///< delta'' (7.17)-(7.18)
@@ -60,8 +71,8 @@ struct PathControlEvaluation {
 /// The law (7.17)-(7.18) on a state-driven steering plugin's acceleration.
 class PathController : public SteeringLaw {
  public:
-  /// `lag` holds the two lagged acceleration measures (empty handles when
-  /// predict_with_acceleration is false).
+  /// ax_lagged, ay_lagged: the two lagged acceleration measures of the
+  /// "lagged" estimate (empty handles otherwise).
   PathController(std::string name, const PathControlParams& params, std::shared_ptr<const ReferencePath> path,
                  const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody::Pin& steer,
                  SimTK::Measure ax_lagged, SimTK::Measure ay_lagged);
@@ -78,11 +89,12 @@ class PathController : public SteeringLaw {
   SimTK::MobilizedBody chassis_;
   SimTK::MobilizedBody::Pin steer_;
   SimTK::Measure ax_, ay_;
+  bool lagged_ = false;
 };
 
 /// Controller plugin: sets a PathController as the law of the named
 /// state-driven steering plugin. Outputs <name>.e1_m, .e2, .e3_m, .e4,
-/// .path_distance_m (signed closest-point distance of the chassis c.m. to
+/// .path_distance_m (signed closest-point distance of the tracked point to
 /// the path, the reported path error).
 class PathControlPlugin : public ControllerPlugin {
  public:
