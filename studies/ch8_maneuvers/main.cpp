@@ -30,6 +30,7 @@ struct Scenario {
   std::string id, description;
   double speed_m_s = 0, t_end_s = 0;
   double abort_path_error_m = 2.0;
+  double path_peak_ay = 0;  ///< U^2 times the reference's largest curvature, m/s^2
   Json path_json;
   std::shared_ptr<const ReferencePath> path;
   PathControlParams gains;
@@ -74,7 +75,8 @@ RunResult runOne(const FourWsParams& vp, const Scenario& sc, const std::string& 
                   "front_steer.rate_rad_s", "front_steer.accel_rad_s2", "front_steer.drift_rad",
                   "rear_steer.angle_rad", "rear_steer.command_rad", "rear_steer.drift_rad", "rear_control.kr",
                   "rear_control.target_rad", "rear_control.tracking_error_rad", "path_control.e1_m",
-                  "path_control.e2", "path_control.e3_m", "path_control.e4", "path_control.path_distance_m"});
+                  "path_control.e2", "path_control.e3_m", "path_control.e4", "path_control.path_distance_m",
+                  "path_control.lateral_acceleration_m_s2"});
     // A run that has lost the path is stopped (an unstable loop would crawl on
     // with ever smaller steps) and recorded as failed.
     const auto progress = study::progress(sc.id + " " + strategyName, sim.t_end_s);
@@ -100,6 +102,8 @@ RunResult runOne(const FourWsParams& vp, const Scenario& sc, const std::string& 
                       {"kr_min", *std::min_element(kr.begin(), kr.end())},
                       {"kr_max", *std::max_element(kr.begin(), kr.end())},
                       {"peak_roll_deg", study::maxAbs(rec.column("chassis.roll_rad")) * kDeg},
+                      {"peak_lateral_acceleration_m_s2",
+                       study::maxAbs(rec.column("path_control.lateral_acceleration_m_s2"))},
                       {"max_rear_tracking_error_rad", study::maxAbs(rec.column("rear_control.tracking_error_rad"))},
                       {"max_steer_drift_rad", std::max(study::maxAbs(rec.column("front_steer.drift_rad")),
                                                        study::maxAbs(rec.column("rear_steer.drift_rad")))},
@@ -129,7 +133,7 @@ void plotScenario(const std::string& png, const Scenario& sc, const std::string&
     << "set multiplot layout 3,2 title '" << sc.id << ": " << sc.description << "' noenhanced\n";
   auto panel = [&](const std::string& title, const std::string& xl, const std::string& yl, const std::string& x,
                    const std::string& y, bool ref) {
-    g << "set title '" << title << "' noenhanced\nset xlabel '" << xl << "'\nset ylabel '" << yl << "'\nplot ";
+    g << "set title '" << title << "' noenhanced\nset xlabel '" << xl << "' noenhanced\nset ylabel '" << yl << "' noenhanced\nplot ";
     bool first = true;
     if (ref) {
       g << "'" << refCsv << "' using (column('x_m')):(column('y_m')) with lines lw 3 lc rgb '#bbbbbb' title 'reference'";
@@ -200,6 +204,8 @@ int main(int argc, char** argv) {
       sc.path_json = r.child("path").json();
       sc.path = makeReferencePath(r.child("path"));
       sc.gains = PathControlParams::fromParams(r.child("gains"));
+      for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
+        sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
       sc.rear = r.has("rear_steer_gains") ? RearSteerParams::fromParams(r.child("rear_steer_gains")) : rearDefault;
       scenarios.push_back(sc);
     }
@@ -233,6 +239,7 @@ int main(int argc, char** argv) {
       for (const auto& st : strategies) {
         RunResult r = runOne(vp, sc, st, linear, table, base, out);
         r.summary["path"] = sc.path_json;
+        r.summary["path_peak_lateral_acceleration_m_s2"] = sc.path_peak_ay;
         r.summary["gains"] = {{"k1_rad_per_s2_per_m", sc.gains.k1_rad_per_s2_per_m},
                               {"k2_rad_per_s2", sc.gains.k2_rad_per_s2},
                               {"k3_rad_per_s2_per_m", sc.gains.k3_rad_per_s2_per_m},
@@ -258,8 +265,8 @@ int main(int argc, char** argv) {
 
     std::printf("ch8_maneuvers: 4WS vehicle, %s at %g, Kr table %s\n", base.integrator.method.c_str(),
                 base.integrator.accuracy, tablePath.c_str());
-    std::printf("  %-5s %-9s %6s %12s %10s %10s %9s %9s %13s %7s\n", "scen", "strategy", "U m/s", "peak v_y m/s",
-                "max err m", "rms err m", "front deg", "rear deg", "Kr min..max", "wall s");
+    std::printf("  %-5s %-9s %6s %12s %10s %10s %9s %9s %13s %15s %7s\n", "scen", "strategy", "U m/s", "peak v_y m/s",
+                "max err m", "rms err m", "front deg", "rear deg", "Kr min..max", "a_y path/car", "wall s");
     for (const Json& j : runs) {
       if (!j["completed"].get<bool>()) {
         std::printf("  %-5s %-9s FAILED: %s\n", j["scenario"].get<std::string>().c_str(),
@@ -267,11 +274,13 @@ int main(int argc, char** argv) {
         continue;
       }
       const double me = j["max_path_error_m"].get<double>(), re = j["rms_path_error_m"].get<double>();
-      std::printf("  %-5s %-9s %6.1f %12.4f %10.4f %10.4f %9.3f %9.3f %6.3f..%-6.3f %7.2f%s\n",
+      std::printf("  %-5s %-9s %6.1f %12.4f %10.4f %10.4f %9.3f %9.3f %6.3f..%-6.3f %7.2f/%-7.2f %7.2f%s\n",
                   j["scenario"].get<std::string>().c_str(), j["strategy"].get<std::string>().c_str(),
                   j["speed_m_s"].get<double>(), j["peak_lateral_velocity_m_s"].get<double>(), me, re,
                   j["peak_front_steer_deg"].get<double>(), j["peak_rear_steer_deg"].get<double>(),
-                  j["kr_min"].get<double>(), j["kr_max"].get<double>(), j["wall_time_s"].get<double>(),
+                  j["kr_min"].get<double>(), j["kr_max"].get<double>(),
+                  j["path_peak_lateral_acceleration_m_s2"].get<double>(),
+                  j["peak_lateral_acceleration_m_s2"].get<double>(), j["wall_time_s"].get<double>(),
                   (me <= 0.10 && re <= 0.03) ? "" : "  (above the 0.10 / 0.03 m bar)");
     }
     std::printf("  total wall time %.1f s; output %s\n", wall, out.c_str());

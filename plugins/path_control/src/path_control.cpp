@@ -155,6 +155,11 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   add("e2", "1", [](const PathControlEvaluation& e) { return e.now.slope; });
   add("e3_m", "m", [](const PathControlEvaluation& e) { return e.ahead.position_m; });
   add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
+  // The estimated acceleration's component normal to the velocity (+ left).
+  add("lateral_acceleration_m_s2", "m/s^2", [](const PathControlEvaluation& e) {
+    const double v = e.v_G.norm();
+    return v > 0 ? (e.v_G[0] * e.a_G[1] - e.v_G[1] * e.a_G[0]) / v : 0.0;
+  });
   const auto path = path_;
   const SimTK::MobilizedBody ch = chassis;
   const Vec3 station = p_.tracked_point_m;

@@ -94,6 +94,7 @@ class PathController : public SteeringLaw {
 
 /// Controller plugin: sets a PathController as the law of the named
 /// state-driven steering plugin. Outputs <name>.e1_m, .e2, .e3_m, .e4,
+/// .lateral_acceleration_m_s2 (the estimated x'' normal to the velocity),
 /// .path_distance_m (signed closest-point distance of the tracked point to
 /// the path, the reported path error).
 class PathControlPlugin : public ControllerPlugin {
