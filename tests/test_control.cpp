@@ -8,6 +8,7 @@
 #include "test_util.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/path_control/path_control.h"
+#include "vdyn/plugins/builtin.h"
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/bicycle.h"
@@ -296,4 +297,30 @@ TEST(RearSteer, TrackingErrorDecaysAsTheG1G2ClosedForm) {
   t.rows = {{12.0, -0.1, 0.002}, {20.0, 0.3, 0.006}};
   EXPECT_LE(rearTrackingMismatch(std::make_shared<NonlinearKrStrategy>(t), kr), 1e-6);
   EXPECT_GT(kr, 0.1);  // c1(16) = 0.1 plus c2 delta_f^2 > 0
+}
+
+TEST(RearSteer, ControllersComeFromTheRegistryWithNamedErrors) {
+  const PluginRegistry& reg = builtinPlugins();
+  EXPECT_TRUE(reg.has(PluginKind::Controller, "path_control"));
+  EXPECT_TRUE(reg.has(PluginKind::Controller, "rear_steer"));
+  const Json rear = {{"rear_steering", "rear_steer"}, {"front_steering", "front_steer"}, {"chassis", "chassis"},
+                     {"strategy", "sideways"}, {"g1_per_s2", 10}, {"g2_per_s", 10}};
+  EXPECT_EQ(test::errorOf([&] {
+              reg.create(PluginKind::Controller, "rear_steer", {"rear_control", ParamReader::fromJson(rear, "scene.json")},
+                         "scene.json controllers[1]");
+            }),
+            "unknown rear steer strategy 'sideways'; known: 2ws, linear, nonlinear");
+  // A path controller from its data-file form drives a bicycle like the C++ one.
+  Bicycle bike(BicycleParams::fromFile("bicycle.json"));
+  bike.addFrontSteering("front_steer", SteeringStateSpec{});
+  const Json pc = {{"steering", "front_steer"},
+                   {"chassis", "chassis"},
+                   {"path", {{"type", "lane_change"}, {"start_y_m", 0.5}, {"length_m", 10}, {"shift_m", 0}}},
+                   {"gains",
+                    {{"k1_rad_per_s2_per_m", 7}, {"k2_rad_per_s2", 0}, {"k3_rad_per_s2_per_m", 0}, {"k4_rad_per_s2", 0},
+                     {"k5_per_s", 0}, {"look_ahead_s", 0.6}}}};
+  bike.updScene().addPlugin(reg.create(PluginKind::Controller, "path_control",
+                                       {"path_control", ParamReader::fromJson(pc, "scene.json")}, "scene.json"));
+  const SimTK::State s = bike.makeInitialState(10.0);
+  EXPECT_NEAR(bike.getScene().evalOutput("front_steer.accel_rad_s2", s), -7 * -0.5, 1e-12);  // -K1 e1
 }
