@@ -132,7 +132,8 @@ double Bicycle::distanceToRearAxle() const {
 
 int Bicycle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
-  return s.getNU() - s.getNUDotErr();
+  // A state-driven steering plugin's steer body moves by a prescribed acceleration.
+  return s.getNU() - s.getNUDotErr() - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
 SimTK::State Bicycle::makeInitialState(double speed) const {

@@ -98,7 +98,8 @@ double FourWsVehicle::totalMass() const {
 
 int FourWsVehicle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
-  return s.getNU() - s.getNUDotErr();
+  // A state-driven steering plugin's steer body moves by a prescribed acceleration.
+  return s.getNU() - s.getNUDotErr() - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
 SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* report) const {
