@@ -76,7 +76,7 @@ TEST(SteeringState, AngleFollowsTheIntegratedLawWithoutDrift) {
   SimTK::State s = bike.makeInitialState(10.0);
   // The steer body adds one prescribed mobility: 9 + 1 mobilities, 1 + 1 constraints.
   EXPECT_EQ(s.getNU(), 10);
-  EXPECT_EQ(bike.degreesOfFreedom(s), 8);  // as with a time command (test_bicycle)
+  EXPECT_EQ(bike.degreesOfFreedom(s), 7);  // 9 - steering - speed hold, as with a time command
   SimulationSettings sim;
   sim.t_end_s = 1.0;
   Recorder rec(bike.getScene(), {"front_steer.angle_rad", "front_steer.command_rad", "front_steer.rate_rad_s",
