@@ -29,9 +29,26 @@ ParamReader::ParamReader(std::shared_ptr<const Json> root, const Json* node, std
   if (!node_->is_object()) throw Error(where_ + ": expected an object");
 }
 
+namespace {
+/// Reads a data file; a file with "based_on": "<other file>" is that file with
+/// its own keys merged over it (RFC 7396 merge patch), so a variant names only
+/// what it changes. Chains are followed (at most 8 deep).
+Json readWithBase(const std::string& resolved, int depth) {
+  Json j = readJsonFile(resolved);
+  if (!j.is_object() || !j.contains("based_on")) return j;
+  const std::string name = resolved.substr(resolved.find_last_of('/') + 1);
+  if (!j["based_on"].is_string()) throw Error(name + ": based_on: expected a data file name");
+  if (depth >= 8) throw Error(name + ": based_on: chain deeper than 8 files (a cycle?)");
+  Json base = readWithBase(resolveDataPath(j["based_on"].get<std::string>()), depth + 1);
+  j.erase("based_on");
+  base.merge_patch(j);
+  return base;
+}
+}  // namespace
+
 ParamReader ParamReader::fromFile(const std::string& path) {
   const std::string resolved = resolveDataPath(path);
-  auto root = std::make_shared<const Json>(readJsonFile(resolved));
+  auto root = std::make_shared<const Json>(readWithBase(resolved, 0));
   const std::string base = resolved.substr(resolved.find_last_of('/') + 1);
   return ParamReader(root, root.get(), base + ":");
 }

@@ -111,6 +111,11 @@ const SteeringPlugin& Bicycle::addFrontSteering(const std::string& name, std::sh
   return static_cast<const SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
 }
 
+SteeringPlugin& Bicycle::addFrontSteering(const std::string& name, const SteeringStateSpec& state) {
+  auto plugin = std::make_unique<SteeringPlugin>(name, "chassis", std::vector<std::string>{"fork"}, state);
+  return static_cast<SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
+}
+
 double Bicycle::totalMass() const {
   return p_.chassis.mass_kg + p_.fork.mass_kg + p_.front_axle.mass_kg + p_.rear_axle.mass_kg;
 }
@@ -127,7 +132,8 @@ double Bicycle::distanceToRearAxle() const {
 
 int Bicycle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
-  return s.getNU() - s.getNUDotErr();
+  // A state-driven steering plugin's steer body moves by a prescribed acceleration.
+  return s.getNU() - s.getNUDotErr() - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
 SimTK::State Bicycle::makeInitialState(double speed) const {
@@ -142,6 +148,7 @@ SimTK::State Bicycle::makeInitialState(double speed) const {
   if (s.getQErr().size() > 0 && s.getQErr().normInf() > 1e-12) {
     SimTK::Assembler assembler(system);
     assembler.lockMobilizer(chassis_.getMobilizedBodyIndex());
+    for (auto mbx : steeringStateBodies(*scene_)) assembler.lockMobilizer(mbx);  // keep delta at its initial value
     assembler.setErrorTolerance(1e-12);
     assembler.assemble(s);
   }

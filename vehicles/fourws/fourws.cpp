@@ -82,6 +82,14 @@ const SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bo
   return static_cast<const SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
 }
 
+SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bool front, const SteeringStateSpec& state) {
+  const int r = front ? RF : RR, l = front ? LF : LR;
+  auto plugin = std::make_unique<SteeringPlugin>(
+      name, "chassis", std::vector<std::string>{std::string(cornerName(r)) + ".knuckle", std::string(cornerName(l)) + ".knuckle"},
+      state, SimTK::UnitVec3(cornerParams_[r].wheel_spin_axis));
+  return static_cast<SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
+}
+
 double FourWsVehicle::totalMass() const {
   double m = p_.chassis.mass_kg;
   for (const auto& c : cornerParams_) m += c.lower_arm.mass_kg + c.knuckle.mass_kg + c.upper_arm.mass_kg + c.wheel.mass_kg;
@@ -90,7 +98,8 @@ double FourWsVehicle::totalMass() const {
 
 int FourWsVehicle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
-  return s.getNU() - s.getNUDotErr();
+  // A state-driven steering plugin's steer body moves by a prescribed acceleration.
+  return s.getNU() - s.getNUDotErr() - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
 SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* report) const {
@@ -120,6 +129,7 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
   }
   std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex()};
   for (const auto& c : corners_) locked.push_back(c.wheel.getMobilizedBodyIndex());
+  for (auto mbx : steeringStateBodies(*scene_)) locked.push_back(mbx);  // keep delta at its initial value
   assembleLoops(system, s, locked, bodies, gap, "4ws", report);
   // Moving forward with every body at the chassis velocity and the wheels rolling.
   s.updU() = 0;

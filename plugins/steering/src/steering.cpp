@@ -1,6 +1,7 @@
 #include "vdyn/steering/steering.h"
 
 #include <cmath>
+#include <functional>
 
 namespace vdyn {
 
@@ -130,6 +131,106 @@ void SteeringConstraintImpl::addInPositionConstraintForces(
   addInBodyTorque(s, B_, -torque_F, bodyForcesInA);
 }
 
+// ---------------------------------------------------------------------------
+// State-driven steering.
+double SteeringLaw::calcAcceleration(const SimTK::State& s) const {
+  const double a = DoCalcAcceleration(s);
+  if (!std::isfinite(a))
+    throw Error("steering law '" + name_ + "': acceleration must be a finite number, got " + formatValue(a) +
+                " at t = " + formatValue(s.getTime()) + " s");
+  return a;
+}
+
+void SteeringStateSpec::validate(const std::string& where) const {
+  requireInRange(initial_angle_rad, -1.2, 1.2, where + " initial_angle_rad");
+  requirePositive(steer_body_inertia_kg_m2, where + " steer_body_inertia_kg_m2");
+}
+
+SteeringStateConstraintImpl::SteeringStateConstraintImpl(SimTK::SimbodyMatterSubsystem& matter,
+                                                         const SimTK::MobilizedBody& chassis,
+                                                         const SimTK::MobilizedBody& knuckle,
+                                                         const SimTK::UnitVec3& spinAxis_K,
+                                                         const SimTK::MobilizedBody& steerBody)
+    : Implementation(matter, 1, 0, 0), spin_K_(spinAxis_K) {
+  B_ = addConstrainedBody(chassis);
+  F_ = addConstrainedBody(knuckle);
+  D_ = addConstrainedBody(steerBody);
+}
+
+// Notation as SteeringConstraintImpl, plus d = the steer body's eta axis and
+// w_D its angular velocity. Phi = b . f - b . d (A.1), with b . d = -sin(delta).
+void SteeringStateConstraintImpl::calcPositionErrors(
+    const SimTK::State&, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
+    const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&, SimTK::Array_<SimTK::Real>& perr) const {
+  const Vec3 b = getBodyRotation(X_AB, B_).x();
+  const Vec3 f = getBodyRotation(X_AB, F_) * Vec3(spin_K_);
+  const Vec3 d = getBodyRotation(X_AB, D_).y();
+  perr[0] = SimTK::dot(b, f - d);
+}
+
+void SteeringStateConstraintImpl::calcPositionDotErrors(
+    const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
+    const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&, SimTK::Array_<SimTK::Real>& pverr) const {
+  const Vec3 b = getBodyRotationFromState(s, B_).x();
+  const Vec3 f = getBodyRotationFromState(s, F_) * Vec3(spin_K_);
+  const Vec3 d = getBodyRotationFromState(s, D_).y();
+  const Vec3 w_B = getBodyAngularVelocity(V_AB, B_), w_F = getBodyAngularVelocity(V_AB, F_),
+             w_D = getBodyAngularVelocity(V_AB, D_);
+  // (A.2): d/dt (b . g) = (w_G - w_B) . (g x b) for g = f, d.
+  pverr[0] = SimTK::dot(w_F - w_B, SimTK::cross(f, b)) - SimTK::dot(w_D - w_B, SimTK::cross(d, b));
+}
+
+void SteeringStateConstraintImpl::calcPositionDotDotErrors(
+    const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
+    const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&, SimTK::Array_<SimTK::Real>& paerr) const {
+  const Vec3 b = getBodyRotationFromState(s, B_).x();
+  const Vec3 w_B = getBodyAngularVelocityFromState(s, B_);
+  const Vec3 a_B = getBodyAngularAcceleration(A_AB, B_);
+  const Vec3 bdot = SimTK::cross(w_B, b);
+  // (A.3)-(A.4) for one term b . g of a body G with angular velocity w_G.
+  auto term = [&](const Vec3& g, const Vec3& w_G, const Vec3& a_G) {
+    const Vec3 gdot = SimTK::cross(w_G, g);
+    return SimTK::dot(a_G - a_B, SimTK::cross(g, b)) + SimTK::dot(w_G - w_B, SimTK::cross(gdot, b) + SimTK::cross(g, bdot));
+  };
+  const Vec3 f = getBodyRotationFromState(s, F_) * Vec3(spin_K_);
+  const Vec3 d = getBodyRotationFromState(s, D_).y();
+  paerr[0] = term(f, getBodyAngularVelocityFromState(s, F_), getBodyAngularAcceleration(A_AB, F_)) -
+             term(d, getBodyAngularVelocityFromState(s, D_), getBodyAngularAcceleration(A_AB, D_));
+}
+
+void SteeringStateConstraintImpl::addInPositionConstraintForces(
+    const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
+    SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
+    SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&) const {
+  const Vec3 b = getBodyRotationFromState(s, B_).x();
+  const Vec3 f = getBodyRotationFromState(s, F_) * Vec3(spin_K_);
+  const Vec3 d = getBodyRotationFromState(s, D_).y();
+  // Torques whose power equals lambda times the velocity-level error.
+  const Vec3 torque_F = multipliers[0] * SimTK::cross(f, b), torque_D = -multipliers[0] * SimTK::cross(d, b);
+  addInBodyTorque(s, F_, torque_F, bodyForcesInA);
+  addInBodyTorque(s, D_, torque_D, bodyForcesInA);
+  addInBodyTorque(s, B_, -torque_F - torque_D, bodyForcesInA);
+}
+
+namespace {
+/// Prescribes the steer body's acceleration u' = delta'' from a law (Simbody
+/// calls it while realizing Dynamics, so the law may use velocities).
+class SteeringLawMotion : public SimTK::Motion::Custom::Implementation {
+ public:
+  explicit SteeringLawMotion(std::function<double(const SimTK::State&)> law) : law_(std::move(law)) {}
+  Implementation* clone() const override { return new SteeringLawMotion(*this); }
+  SimTK::Motion::Level getLevel(const SimTK::State&) const override { return SimTK::Motion::Acceleration; }
+  void calcPrescribedAcceleration(const SimTK::State& s, int nu, SimTK::Real* udot) const override {
+    assert(nu == 1);
+    (void)nu;
+    udot[0] = law_(s);
+  }
+
+ private:
+  std::function<double(const SimTK::State&)> law_;
+};
+}  // namespace
+
 double steeringAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& knuckle,
                      const SimTK::UnitVec3& spinAxis_K) {
   const Vec3 b = chassis.getBodyRotation(s).x();
@@ -149,7 +250,103 @@ SteeringPlugin::SteeringPlugin(std::string name, std::string chassisBody, std::v
   if (knuckles_.empty()) throw Error("steering plugin '" + this->name() + "': no knuckles listed");
 }
 
+SteeringPlugin::SteeringPlugin(std::string name, std::string chassisBody, std::vector<std::string> knuckles,
+                               const SteeringStateSpec& state, SimTK::UnitVec3 spinAxis_K)
+    : ConstraintPlugin("steering", std::move(name)),
+      chassis_(std::move(chassisBody)),
+      knuckles_(std::move(knuckles)),
+      spin_K_(spinAxis_K),
+      stateDriven_(true),
+      state_(state) {
+  state_.validate("steering plugin '" + this->name() + "'");
+  if (knuckles_.empty()) throw Error("steering plugin '" + this->name() + "': no knuckles listed");
+}
+
+const SteeringCommand& SteeringPlugin::command() const {
+  if (!command_) throw Error("steering plugin '" + name() + "' is state-driven: it has no time command");
+  return *command_;
+}
+
+void SteeringPlugin::setAccelerationLaw(std::shared_ptr<const SteeringLaw> law) {
+  if (!stateDriven_)
+    throw Error("steering plugin '" + name() + "' follows a time command; a law needs a state-driven plugin");
+  if (!law) throw Error("steering plugin '" + name() + "': empty acceleration law");
+  if (slot_->law)
+    throw Error("steering plugin '" + name() + "' already has the law '" + slot_->law->name() + "'; cannot add '" +
+                law->name() + "'");
+  slot_->law = std::move(law);
+}
+
+bool SteeringPlugin::hasAccelerationLaw() const { return slot_->law != nullptr; }
+
+double SteeringPlugin::getAngle(const SimTK::State& s) const {
+  assert(stateDriven_);
+  return steer_.getAngle(s);
+}
+
+double SteeringPlugin::getRate(const SimTK::State& s) const {
+  assert(stateDriven_);
+  return steer_.getRate(s);
+}
+
+double SteeringPlugin::calcAcceleration(const SimTK::State& s) const {
+  assert(stateDriven_ && slot_->law);
+  return slot_->law->calcAcceleration(s);
+}
+
+const SimTK::MobilizedBody::Pin& SteeringPlugin::getSteerBody() const {
+  assert(stateDriven_);
+  return steer_;
+}
+
+void SteeringPlugin::DoInitialize(const Scene&, SimTK::State&) const {
+  if (stateDriven_ && !slot_->law)
+    throw Error("steering plugin '" + name() + "' is state-driven but no controller set its acceleration law");
+}
+
+void SteeringPlugin::addStateDriven(Scene& scene) {
+  SimTK::MobilizedBody& chassis = const_cast<SimTK::MobilizedBody&>(scene.getBody(chassis_));
+  // The steer body: a Pin about the chassis zeta axis (Simbody's Pin turns
+  // about z), so q = delta (+ left) and u = delta'.
+  const double I = state_.steer_body_inertia_kg_m2;
+  const SimTK::Body::Rigid body(SimTK::MassProperties(1e-3, Vec3(0), SimTK::Inertia(I)));
+  steer_ = SimTK::MobilizedBody::Pin(chassis, SimTK::Transform(), body, SimTK::Transform());
+  steer_.setDefaultAngle(state_.initial_angle_rad);
+  const auto slot = slot_;
+  const std::string who = name();
+  SimTK::Motion::Custom(steer_, new SteeringLawMotion([slot, who](const SimTK::State& s) {
+    if (!slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
+    return slot->law->calcAcceleration(s);
+  }));
+  scene.addBody(name() + ".steer", steer_);
+  for (const auto& k : knuckles_)
+    SimTK::Constraint::Custom(
+        new SteeringStateConstraintImpl(scene.updMatter(), chassis, scene.getBody(k), spin_K_, steer_));
+  const SimTK::MobilizedBody::Pin steer = steer_;
+  const SimTK::MobilizedBody ch = chassis, first = scene.getBody(knuckles_.front());
+  const SimTK::UnitVec3 axis = spin_K_;
+  scene.addOutput({name() + ".command_rad", "rad", SimTK::Stage::Position,
+                   [steer](const SimTK::State& s) { return steer.getAngle(s); }});
+  scene.addOutput({name() + ".rate_rad_s", "rad/s", SimTK::Stage::Velocity,
+                   [steer](const SimTK::State& s) { return steer.getRate(s); }});
+  scene.addOutput({name() + ".accel_rad_s2", "rad/s^2", SimTK::Stage::Velocity, [slot, who](const SimTK::State& s) {
+                     if (!slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
+                     return slot->law->calcAcceleration(s);
+                   }});
+  scene.addOutput({name() + ".angle_rad", "rad", SimTK::Stage::Position,
+                   [ch, first, axis](const SimTK::State& s) { return steeringAngle(s, ch, first, axis); }});
+  // The wheel's angle against its integrated state: what an acceleration-only
+  // command would let drift, here held by the constraint (per first knuckle).
+  scene.addOutput({name() + ".drift_rad", "rad", SimTK::Stage::Position, [ch, first, axis, steer](const SimTK::State& s) {
+                     return steeringAngle(s, ch, first, axis) - steer.getAngle(s);
+                   }});
+}
+
 void SteeringPlugin::DoAddTo(Scene& scene) {
+  if (stateDriven_) {
+    addStateDriven(scene);
+    return;
+  }
   const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
   for (const auto& k : knuckles_)
     SimTK::Constraint::Custom(
@@ -161,6 +358,14 @@ void SteeringPlugin::DoAddTo(Scene& scene) {
   const SimTK::UnitVec3 axis = spin_K_;
   scene.addOutput({name() + ".angle_rad", "rad", SimTK::Stage::Position,
                    [chassis, first, axis](const SimTK::State& s) { return steeringAngle(s, chassis, first, axis); }});
+}
+
+std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene) {
+  std::vector<SimTK::MobilizedBodyIndex> bodies;
+  for (const auto& p : scene.getPlugins())
+    if (const auto* st = dynamic_cast<const SteeringPlugin*>(p.get()); st && st->isStateDriven())
+      bodies.push_back(st->getSteerBody().getMobilizedBodyIndex());
+  return bodies;
 }
 
 void registerSteeringPlugins(PluginRegistry& registry) {
@@ -180,9 +385,15 @@ void registerSteeringPlugins(PluginRegistry& registry) {
       const Json& j = spec.params.json().at("knuckles");
       for (const auto& k : j) knuckles.push_back(k.get<std::string>());
     }
-    return std::make_unique<SteeringPlugin>(
-        spec.name, spec.bound("chassis"), knuckles, makeSteeringCommand(spec.params.child("command")),
-        SimTK::UnitVec3(spec.params.vec3Or("spin_axis", Vec3(0, 1, 0))));
+    const SimTK::UnitVec3 spin(spec.params.vec3Or("spin_axis", Vec3(0, 1, 0)));
+    const ParamReader command = spec.params.child("command");
+    if (command.stringOr("type", "") == "state") {
+      SteeringStateSpec st;
+      st.initial_angle_rad = command.numberOr("initial_rad", 0.0);
+      return std::make_unique<SteeringPlugin>(spec.name, spec.bound("chassis"), knuckles, st, spin);
+    }
+    return std::make_unique<SteeringPlugin>(spec.name, spec.bound("chassis"), knuckles, makeSteeringCommand(command),
+                                            spin);
   });
 }
 

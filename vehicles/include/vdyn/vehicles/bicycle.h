@@ -58,6 +58,8 @@ class Bicycle {
 
   /// Adds the front steering (a SteeringPlugin on the fork); call before making states.
   const SteeringPlugin& addFrontSteering(const std::string& name, std::shared_ptr<const SteeringCommand> command);
+  /// The same, state-driven: a controller plugin sets delta'' (see SteeringPlugin).
+  SteeringPlugin& addFrontSteering(const std::string& name, const SteeringStateSpec& state);
 
   /// Level, at the height where the tires carry the weight, heading +x at
   /// `speed_m_s`, the axles rolling freely. Constraints are assembled.

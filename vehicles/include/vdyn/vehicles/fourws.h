@@ -57,6 +57,8 @@ class FourWsVehicle {
   /// axle with the same angle; call before making states.
   const SteeringPlugin& addAxleSteering(const std::string& name, bool front,
                                         std::shared_ptr<const SteeringCommand> command);
+  /// The same, state-driven: a controller plugin sets delta'' (see SteeringPlugin).
+  SteeringPlugin& addAxleSteering(const std::string& name, bool front, const SteeringStateSpec& state);
 
   double totalMass() const;
   /// Mobilities minus constraint equations (the chassis quaternion counts as 3).

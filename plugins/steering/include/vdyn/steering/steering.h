@@ -11,6 +11,18 @@
 // equations of motion and projects the position and velocity levels, so the
 // angle stays on its command instead of drifting from the integral of an
 // acceleration command.
+//
+// State-driven steering (a controller's output, chapters 7-8): when delta'' is
+// a function of the state, delta and delta' must be states. The plugin then adds
+// a light "steer" body on a Pin about the chassis zeta axis whose angle q is
+// delta and whose rate u is delta'; a Simbody Motion at the acceleration level
+// prescribes u' = delta'' from a SteeringLaw (q and u are integrated like any
+// other coordinate), and the holonomic constraint
+//     Phi = x_B . s_F - x_B . y_D = 0,   x_B . y_D = -sin(q)             (A.1)
+// keeps each knuckle's angle on q (y_D the steer body's eta axis), so the wheel
+// angle cannot drift from the integrated delta beyond the constraint tolerance
+// (output <name>.drift_rad). Every term depends on q only, as Simbody's stages
+// require (z variables may only affect Dynamics and later).
 #include <memory>
 #include <string>
 #include <vector>
@@ -83,11 +95,68 @@ class StepSequenceCommand : public SteeringCommand {
   std::vector<SmoothStepCommand> steps_;
 };
 
+/// A steering acceleration law: delta'' (rad/s^2, + toward left) as a function of
+/// the state, e.g. a path controller. It may depend on positions, velocities and
+/// z variables (Stage::Velocity and the Time-stage z's), never on accelerations.
+class SteeringLaw {
+ public:
+  virtual ~SteeringLaw() = default;
+  /// delta'' on a state realized to Stage::Velocity; throws Error naming the law
+  /// and the time if it is not a finite number.
+  double calcAcceleration(const SimTK::State& s) const;
+  const std::string& name() const { return name_; }
+
+ protected:
+  explicit SteeringLaw(std::string name) : name_(std::move(name)) {}
+  virtual double DoCalcAcceleration(const SimTK::State& s) const = 0;
+
+ private:
+  std::string name_;
+};
+
+/// Options of a state-driven steering plugin.
+struct SteeringStateSpec {
+  double initial_angle_rad = 0.0;  ///< delta at the start, rad, + left
+  /// Inertia of the steer body about its axis, kg m^2 (its mass is 1e-3 kg).
+  /// Its motion is prescribed, so it only adds a reaction torque I delta'' on
+  /// the chassis (1e-6 kg m^2: below 1e-5 N m at 10 rad/s^2).
+  double steer_body_inertia_kg_m2 = 1e-6;
+  void validate(const std::string& where) const;
+};
+
 /// {"type": "hold", "angle_rad": 0}, {"type": "smooth_step", "initial_rad": 0,
 /// "final_rad": 0.0698, "start_time_s": 0.5, "duration_s": 1.0}, or
 /// {"type": "steps", "initial_rad": 0, "steps": [{"start_time_s": 0.5,
 /// "duration_s": 0.5, "change_rad": 0.035}, ...]}.
 std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r);
+
+/// The constraint of one wheel on a steer body D (state-driven steering):
+/// Phi = x_B . (s_F - y_D) = 0.
+class SteeringStateConstraintImpl : public SimTK::Constraint::Custom::Implementation {
+ public:
+  SteeringStateConstraintImpl(SimTK::SimbodyMatterSubsystem& matter, const SimTK::MobilizedBody& chassis,
+                              const SimTK::MobilizedBody& knuckle, const SimTK::UnitVec3& spinAxis_K,
+                              const SimTK::MobilizedBody& steerBody);
+  Implementation* clone() const override { return new SteeringStateConstraintImpl(*this); }
+
+  void calcPositionErrors(const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
+                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                          SimTK::Array_<SimTK::Real>& perr) const override;
+  void calcPositionDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
+                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                             SimTK::Array_<SimTK::Real>& pverr) const override;
+  void calcPositionDotDotErrors(const SimTK::State& s,
+                                const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
+                                const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                                SimTK::Array_<SimTK::Real>& paerr) const override;
+  void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
+                                     SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
+                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const override;
+
+ private:
+  SimTK::ConstrainedBodyIndex B_, F_, D_;  // chassis, knuckle, steer body
+  SimTK::UnitVec3 spin_K_;
+};
 
 /// The constraint of one wheel (Constraint::Custom implementation).
 class SteeringConstraintImpl : public SimTK::Constraint::Custom::Implementation {
@@ -124,25 +193,63 @@ double steeringAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis,
 /// Steering plugin: the same command on every listed knuckle (left and right
 /// wheels of an axle take the same angle, as in the seed). Outputs:
 /// <name>.command_rad and <name>.angle_rad (the first knuckle's measured angle).
+///
+/// State-driven (constructed with a SteeringStateSpec): delta and delta' are
+/// the coordinate and rate of the steer body <name>.steer, delta'' comes from
+/// the law a controller sets with setAccelerationLaw(). Outputs then also
+/// <name>.rate_rad_s (delta'), <name>.accel_rad_s2 (delta'') and
+/// <name>.drift_rad (measured angle - delta); <name>.command_rad is delta.
 class SteeringPlugin : public ConstraintPlugin {
  public:
   SteeringPlugin(std::string name, std::string chassisBody, std::vector<std::string> knuckleBodies,
                  std::shared_ptr<const SteeringCommand> command,
                  SimTK::UnitVec3 spinAxis_K = SimTK::UnitVec3(SimTK::YAxis));
-  const SteeringCommand& command() const { return *command_; }
+  SteeringPlugin(std::string name, std::string chassisBody, std::vector<std::string> knuckleBodies,
+                 const SteeringStateSpec& state, SimTK::UnitVec3 spinAxis_K = SimTK::UnitVec3(SimTK::YAxis));
+  /// The time command (throws Error for a state-driven plugin).
+  const SteeringCommand& command() const;
+
+  bool isStateDriven() const { return stateDriven_; }
+  /// Sets the law of a state-driven plugin (once, before the scene is
+  /// finalized). Throws Error for a time-commanded plugin or a second law.
+  void setAccelerationLaw(std::shared_ptr<const SteeringLaw> law);
+  bool hasAccelerationLaw() const;
+  /// State-driven only (asserted): delta (rad), delta' (rad/s) and delta''
+  /// (rad/s^2, from the law; needs Stage::Velocity).
+  double getAngle(const SimTK::State& s) const;
+  double getRate(const SimTK::State& s) const;
+  double calcAcceleration(const SimTK::State& s) const;
+  /// State-driven only: the steer body (added to the scene as <name>.steer).
+  const SimTK::MobilizedBody::Pin& getSteerBody() const;
 
  protected:
   void DoAddTo(Scene& scene) override;
+  void DoInitialize(const Scene& scene, SimTK::State& state) const override;
 
  private:
+  struct LawSlot {
+    std::shared_ptr<const SteeringLaw> law;
+  };
+  void addStateDriven(Scene& scene);
   std::string chassis_;
   std::vector<std::string> knuckles_;
   std::shared_ptr<const SteeringCommand> command_;
   SimTK::UnitVec3 spin_K_;
+  bool stateDriven_ = false;
+  SteeringStateSpec state_;
+  std::shared_ptr<LawSlot> slot_ = std::make_shared<LawSlot>();
+  SimTK::MobilizedBody::Pin steer_;
 };
+
+/// Mobilizers of the steer bodies of every state-driven steering plugin of the
+/// scene: vehicle builders lock them when they assemble, so that assembly moves
+/// the knuckles to the commanded angle rather than the command to the knuckles.
+std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene);
 
 /// Registers "steering": {"chassis": "chassis", "knuckles": ["rf.knuckle", "lf.knuckle"],
 /// "spin_axis": [0, 1, 0], "command": {...}} (chassis and knuckles may be bound).
+/// A command {"type": "state", "initial_rad": 0} makes it state-driven (a
+/// controller plugin then sets its law).
 void registerSteeringPlugins(PluginRegistry& registry);
 
 }  // namespace vdyn

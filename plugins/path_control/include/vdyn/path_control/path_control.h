@@ -1,0 +1,120 @@
+#pragma once
+// The seed's closed-loop path controller (section 7.3, (7.9)-(7.18); DESIGN.md
+// section 6): the front steering acceleration from the position and slope
+// errors of the chassis centre of mass against a reference path, now (e1, e2)
+// and at the position predicted a time dT ahead (e3, e4), with an artificial
+// damper on the steering rate:
+//     x(t + dT) = x + x' dT + x'' dT^2 / 2,   x'(t + dT) = x' + x'' dT  (7.13)-(7.16)
+//     delta'' = -(K1 e1 + K2 e2 + K3 e3 + K4 e4) - K5 delta'            (7.17)-(7.18)
+// The errors and their signs are the path's (vdyn/path/path.h: > 0 left of
+// the path), so positive gains steer back toward it.
+//
+// The chassis acceleration x'' of (7.13)-(7.16) cannot be the one Simbody
+// computes from this very law (x'' depends on delta''). The seed assumes it
+// changes smoothly; here the measured acceleration of the tracked point
+// enters through a first-order lag of time constant tau (two z variables,
+// a' = (x'' - a) / tau, integrated with error control), a stated choice
+// (acceleration_estimate "lagged"; "none" drops x''). The term matters: the
+// tire force answers a steering change at once, so x'' puts a term
+// proportional to delta into (7.17) and damps the fast loop
+// delta -> tire force -> e3 -> delta''. Estimating x'' from the yaw rate,
+// r (-y', x'), loses that term, and the seed's gains then oscillate (measured
+// on the bicycle); so does a lag tau of 0.02 s or more.
+#include <memory>
+#include <string>
+
+#include <Simbody.h>
+
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+#include "vdyn/path/path.h"
+#include "vdyn/steering/steering.h"
+
+namespace vdyn {
+
+/// Gains and look-ahead of (7.17)-(7.18). Filled by C++ or fromParams.
+struct PathControlParams {
+  double k1_rad_per_s2_per_m = 10;  ///< K1, on e1 (position now), rad/s^2 per m
+  double k2_rad_per_s2 = 2;         ///< K2, on e2 (slope now), rad/s^2 per unit slope (J-turn: per rad)
+  double k3_rad_per_s2_per_m = 100; ///< K3, on e3 (position at t + dT), rad/s^2 per m
+  double k4_rad_per_s2 = 5;         ///< K4, on e4 (slope at t + dT), rad/s^2 per unit slope (J-turn: per rad)
+  double k5_per_s = 10;             ///< K5, the artificial damper on delta' (7.18), 1/s
+  double look_ahead_s = 0.6;        ///< dT of (7.13)-(7.16), s (>= 0)
+  /// x'' in (7.13)-(7.16): "lagged" or "none" (see above).
+  std::string acceleration_estimate = "lagged";
+  /// tau of the "lagged" estimate, s (> 0). It must stay well below the fast
+  /// loop's period: on the bicycle at 10 m/s, 0.02 s already excites it (36 deg
+  /// steering peaks) and 0.05 s diverges.
+  double acceleration_lag_s = 0.003;
+  /// The chassis point that follows the path, in the chassis frame, m (the
+  /// seed: the centre of mass, [0, 0, 0]). A point at ground level keeps the
+  /// chassis roll out of the errors (the bicycle's roll on its tires alone is
+  /// a lightly damped 3.5 Hz mode that the c.m. would feed back).
+  SimTK::Vec3 tracked_point_m{0, 0, 0};
+
+  void validate() const;
+  /// Keys k1_rad_per_s2_per_m, k2_rad_per_s2, k3_rad_per_s2_per_m,
+  /// k4_rad_per_s2, k5_per_s, look_ahead_s (all required), and optional
+  /// acceleration_estimate, acceleration_lag_s, tracked_point_m.
+  static PathControlParams fromParams(const ParamReader& r);
+};
+
+/// What the controller sees on a state (Stage::Velocity).
+struct PathControlEvaluation {
+  SimTK::Vec2 p_G{0, 0}, v_G{0, 0}, a_G{0, 0};  ///< tracked point's position, velocity, estimated acceleration
+  SimTK::Vec2 p_ahead_G{0, 0}, v_ahead_G{0, 0}; ///< predicted at t + dT (7.13)-(7.16)
+  PathErrors now, ahead;                ///< (e1, e2) and (e3, e4)
+  double steer_rate_rad_s = 0;          ///< delta'
+  double accel_rad_s2 = 0;              ///< delta'' (7.17)-(7.18)
+};
+
+/// The law (7.17)-(7.18) on a state-driven steering plugin's acceleration.
+class PathController : public SteeringLaw {
+ public:
+  /// ax_lagged, ay_lagged: the two lagged acceleration measures of the
+  /// "lagged" estimate (empty handles otherwise).
+  PathController(std::string name, const PathControlParams& params, std::shared_ptr<const ReferencePath> path,
+                 const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody::Pin& steer,
+                 SimTK::Measure ax_lagged, SimTK::Measure ay_lagged);
+  PathControlEvaluation calcEvaluation(const SimTK::State& s) const;
+  const PathControlParams& params() const { return p_; }
+  const ReferencePath& path() const { return *path_; }
+
+ protected:
+  double DoCalcAcceleration(const SimTK::State& s) const override { return calcEvaluation(s).accel_rad_s2; }
+
+ private:
+  PathControlParams p_;
+  std::shared_ptr<const ReferencePath> path_;
+  SimTK::MobilizedBody chassis_;
+  SimTK::MobilizedBody::Pin steer_;
+  SimTK::Measure ax_, ay_;
+  bool lagged_ = false;
+};
+
+/// Controller plugin: sets a PathController as the law of the named
+/// state-driven steering plugin. Outputs <name>.e1_m, .e2, .e3_m, .e4,
+/// .lateral_acceleration_m_s2 (the estimated x'' normal to the velocity),
+/// .path_distance_m (signed closest-point distance of the tracked point to
+/// the path, the reported path error).
+class PathControlPlugin : public ControllerPlugin {
+ public:
+  PathControlPlugin(std::string name, std::string steeringPlugin, std::string chassisBody,
+                    std::shared_ptr<const ReferencePath> path, const PathControlParams& params);
+  const PathController& controller() const;
+
+ protected:
+  void DoAddTo(Scene& scene) override;
+
+ private:
+  std::string steering_, chassis_;
+  std::shared_ptr<const ReferencePath> path_;
+  PathControlParams p_;
+  std::shared_ptr<const PathController> law_;
+};
+
+/// Registers "path_control": {"steering": "front_steer", "chassis": "chassis",
+/// "path": {...makeReferencePath}, "gains": {...PathControlParams}}.
+void registerPathControlPlugins(PluginRegistry& registry);
+
+}  // namespace vdyn

@@ -1,0 +1,180 @@
+#include "vdyn/path_control/path_control.h"
+
+#include <cmath>
+
+namespace vdyn {
+
+using SimTK::Vec2;
+using SimTK::Vec3;
+
+void PathControlParams::validate() const {
+  requireNonNegative(k1_rad_per_s2_per_m, "path control k1_rad_per_s2_per_m");
+  requireNonNegative(k2_rad_per_s2, "path control k2_rad_per_s2");
+  requireNonNegative(k3_rad_per_s2_per_m, "path control k3_rad_per_s2_per_m");
+  requireNonNegative(k4_rad_per_s2, "path control k4_rad_per_s2");
+  requireNonNegative(k5_per_s, "path control k5_per_s");
+  requireNonNegative(look_ahead_s, "path control look_ahead_s");
+  requirePositive(acceleration_lag_s, "path control acceleration_lag_s");
+  for (int i = 0; i < 3; ++i) requireFinite(tracked_point_m[i], "path control tracked_point_m");
+  if (acceleration_estimate != "lagged" && acceleration_estimate != "none")
+    throw Error("path control acceleration_estimate must be \"lagged\" or \"none\", got \"" +
+                acceleration_estimate + "\"");
+}
+
+PathControlParams PathControlParams::fromParams(const ParamReader& r) {
+  PathControlParams p;
+  p.k1_rad_per_s2_per_m = r.number("k1_rad_per_s2_per_m");
+  p.k2_rad_per_s2 = r.number("k2_rad_per_s2");
+  p.k3_rad_per_s2_per_m = r.number("k3_rad_per_s2_per_m");
+  p.k4_rad_per_s2 = r.number("k4_rad_per_s2");
+  p.k5_per_s = r.number("k5_per_s");
+  p.look_ahead_s = r.number("look_ahead_s");
+  p.acceleration_estimate = r.stringOr("acceleration_estimate", p.acceleration_estimate);
+  p.acceleration_lag_s = r.numberOr("acceleration_lag_s", p.acceleration_lag_s);
+  p.tracked_point_m = r.vec3Or("tracked_point_m", p.tracked_point_m);
+  p.validate();
+  return p;
+}
+
+// ---------------------------------------------------------------------------
+PathController::PathController(std::string name, const PathControlParams& params,
+                               std::shared_ptr<const ReferencePath> path, const SimTK::MobilizedBody& chassis,
+                               const SimTK::MobilizedBody::Pin& steer, SimTK::Measure ax, SimTK::Measure ay)
+    : SteeringLaw(std::move(name)), p_(params), path_(std::move(path)), chassis_(chassis), steer_(steer), ax_(ax),
+      ay_(ay) {
+  p_.validate();
+  if (!path_) throw Error("path controller '" + this->name() + "': no path");
+  assert(p_.acceleration_estimate != "lagged" || (!ax_.isEmptyHandle() && !ay_.isEmptyHandle()));
+  lagged_ = p_.acceleration_estimate == "lagged";
+}
+
+PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) const {
+  PathControlEvaluation e;
+  const Vec3 p = chassis_.findStationLocationInGround(s, p_.tracked_point_m),
+             v = chassis_.findStationVelocityInGround(s, p_.tracked_point_m);
+  e.p_G = Vec2(p[0], p[1]);
+  e.v_G = Vec2(v[0], v[1]);
+  e.a_G = lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0);
+  const double dT = p_.look_ahead_s;
+  e.p_ahead_G = e.p_G + e.v_G * dT + e.a_G * (dT * dT / 2);  // (7.13)-(7.14)
+  e.v_ahead_G = e.v_G + e.a_G * dT;                           // (7.15)-(7.16)
+  e.now = path_->calcErrors(e.p_G, e.v_G);                    // e1, e2 (7.9)-(7.10), (7.19)-(7.21)
+  e.ahead = path_->calcErrors(e.p_ahead_G, e.v_ahead_G);      // e3, e4
+  e.steer_rate_rad_s = steer_.getRate(s);
+  // (7.17) with the artificial damper (7.18).
+  e.accel_rad_s2 = -(p_.k1_rad_per_s2_per_m * e.now.position_m + p_.k2_rad_per_s2 * e.now.slope +
+                     p_.k3_rad_per_s2_per_m * e.ahead.position_m + p_.k4_rad_per_s2 * e.ahead.slope) -
+                   p_.k5_per_s * e.steer_rate_rad_s;
+  return e;
+}
+
+// ---------------------------------------------------------------------------
+namespace {
+/// One horizontal component a of the tracked point's acceleration through a
+/// first-order lag: a z variable with a' = (x'' - a) / tau. Its value is read
+/// from z directly (no cache entry: z can change without Stage::Time being
+/// invalidated). The derivative is set while the force subsystem realizes
+/// Acceleration, after Simbody has computed the matter's accelerations.
+class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
+ public:
+  class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
+   public:
+    Implementation(const SimTK::MobilizedBody& body, const Vec3& station, int axis, double tau)
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0), body_(body), station_(station), axis_(axis), tau_(tau) {}
+    Implementation* cloneVirtual() const override { return new Implementation(*this); }
+    int getNumTimeDerivativesVirtual() const override { return 0; }
+    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
+    const SimTK::Real& getUncachedValueVirtual(const SimTK::State& s, int derivOrder) const override {
+      assert(derivOrder == 0);
+      (void)derivOrder;
+      return getSubsystem().getZ(s)[zIndex_];
+    }
+    void realizeMeasureTopologyVirtual(SimTK::State& s) const override {
+      zIndex_ = getSubsystem().allocateZ(s, SimTK::Vector(1, 0.0));
+    }
+    void initializeVirtual(SimTK::State& s) const override { getSubsystem().updZ(s)[zIndex_] = 0; }
+    void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
+      const double a = body_.findStationAccelerationInGround(s, station_)[axis_];
+      getSubsystem().updZDot(s)[zIndex_] = (a - getSubsystem().getZ(s)[zIndex_]) / tau_;
+    }
+
+   private:
+    SimTK::MobilizedBody body_;
+    Vec3 station_;
+    int axis_;
+    double tau_;
+    mutable SimTK::ZIndex zIndex_;
+  };
+  LaggedAccelerationMeasure(SimTK::Subsystem& sub, Implementation* impl)
+      : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
+};
+
+SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, const Vec3& station, int axis,
+                                     double tau) {
+  return LaggedAccelerationMeasure(scene.updForces(),
+                                   new LaggedAccelerationMeasure::Implementation(chassis, station, axis, tau));
+}
+}  // namespace
+
+PathControlPlugin::PathControlPlugin(std::string name, std::string steeringPlugin, std::string chassisBody,
+                                     std::shared_ptr<const ReferencePath> path, const PathControlParams& params)
+    : ControllerPlugin("path_control", std::move(name)),
+      steering_(std::move(steeringPlugin)),
+      chassis_(std::move(chassisBody)),
+      path_(std::move(path)),
+      p_(params) {
+  p_.validate();
+  if (!path_) throw Error("path control plugin '" + this->name() + "': no path");
+}
+
+const PathController& PathControlPlugin::controller() const {
+  if (!law_) throw Error("path control plugin '" + name() + "' is not added to a scene yet");
+  return *law_;
+}
+
+void PathControlPlugin::DoAddTo(Scene& scene) {
+  auto* steer = scene.findPlugin<SteeringPlugin>(steering_);
+  if (!steer) throw Error("path control plugin '" + name() + "': the scene has no steering plugin '" + steering_ + "'");
+  if (!steer->isStateDriven())
+    throw Error("path control plugin '" + name() + "': steering plugin '" + steering_ +
+                "' follows a time command; the controller needs a state-driven one");
+  const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
+  SimTK::Measure ax, ay;
+  if (p_.acceleration_estimate == "lagged") {
+    ax = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 0, p_.acceleration_lag_s);
+    ay = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 1, p_.acceleration_lag_s);
+  }
+  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, steer->getSteerBody(), ax, ay);
+  steer->setAccelerationLaw(law_);
+  const auto law = law_;
+  auto add = [&](const std::string& key, const std::string& unit, auto f) {
+    scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity,
+                     [law, f](const SimTK::State& s) { return f(law->calcEvaluation(s)); }});
+  };
+  add("e1_m", "m", [](const PathControlEvaluation& e) { return e.now.position_m; });
+  add("e2", "1", [](const PathControlEvaluation& e) { return e.now.slope; });
+  add("e3_m", "m", [](const PathControlEvaluation& e) { return e.ahead.position_m; });
+  add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
+  // The estimated acceleration's component normal to the velocity (+ left).
+  add("lateral_acceleration_m_s2", "m/s^2", [](const PathControlEvaluation& e) {
+    const double v = e.v_G.norm();
+    return v > 0 ? (e.v_G[0] * e.a_G[1] - e.v_G[1] * e.a_G[0]) / v : 0.0;
+  });
+  const auto path = path_;
+  const SimTK::MobilizedBody ch = chassis;
+  const Vec3 station = p_.tracked_point_m;
+  scene.addOutput({name() + ".path_distance_m", "m", SimTK::Stage::Position, [path, ch, station](const SimTK::State& s) {
+                     const Vec3 p = ch.findStationLocationInGround(s, station);
+                     return path->calcDistance(Vec2(p[0], p[1]));
+                   }});
+}
+
+void registerPathControlPlugins(PluginRegistry& registry) {
+  registry.add(PluginKind::Controller, "path_control", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+    return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"),
+                                               makeReferencePath(spec.params.child("path")),
+                                               PathControlParams::fromParams(spec.params.child("gains")));
+  });
+}
+
+}  // namespace vdyn

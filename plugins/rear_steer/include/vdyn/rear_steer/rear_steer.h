@@ -1,0 +1,185 @@
+#pragma once
+// Rear-steer strategies of chapter 8 (DESIGN.md sections 5 and 6): the rear
+// steering angle follows a target delta_r* = f(delta_f) set by the steering
+// angle ratio Kr = delta_r / delta_f, and its acceleration is commanded as
+//     delta_r'' = delta_r*'' + G1 (delta_r* - delta_r) + G2 (delta_r*' - delta_r')   (8.5), (8.8)
+// with delta_r*' and delta_r*'' from the front angle's rate and acceleration
+// (the front's path controller output). Strategies:
+//   2ws        delta_r* = 0 (conventional front steering);
+//   linear     delta_r* = Kr(U) delta_f, Kr of the linear bicycle at the
+//              current speed U (zero steady side slip)              (8.2)-(8.4)
+//   nonlinear  Kr = C1 + C2 delta_f^2 (delta_f in degrees) (8.1), C1 and C2
+//              interpolated in speed from a coefficient table (Table 8.1):
+//              delta_r* = C1 delta_f + C2 delta_f^3,                (8.6)
+//              delta_r*' = (C1 + 3 C2 delta_f^2) delta_f',          (8.7)
+//              delta_r*'' = (C1 + 3 C2 delta_f^2) delta_f'' + 6 C2 delta_f delta_f'^2   (8.8)
+//              (the scan's "5 C2" read as 6 C2, the derivative of (8.7)).
+// Kr is evaluated at the current speed and its time derivative through U is
+// neglected (the seed's manoeuvres hold the speed constant).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+#include "vdyn/steering/steering.h"
+
+namespace vdyn {
+
+/// The linear bicycle of chapter 6 (6.1)-(6.9), for Kr(U).
+struct LinearBicycleParams {
+  double mass_kg = 1024;                              ///< M (chapter 6)
+  double front_axle_to_cm_m = 1.305;                  ///< a, m
+  double rear_axle_to_cm_m = 0.965;                   ///< b, m
+  double front_cornering_stiffness_N_per_rad = 1.4e5; ///< C_af, both tires of the axle, N/rad
+  double rear_cornering_stiffness_N_per_rad = 1.4e5;  ///< C_ar, N/rad
+
+  void validate() const;
+  /// Keys mass_kg, front_axle_to_cm_m, rear_axle_to_cm_m,
+  /// front_cornering_stiffness_N_per_rad, rear_cornering_stiffness_N_per_rad.
+  static LinearBicycleParams fromParams(const ParamReader& r);
+  /// Zero steady side slip: Kr = (-b + M a U^2 / (C_ar l)) / (a + M b U^2 / (C_af l)),
+  /// l = a + b (DESIGN.md section 5). Negative below about 14 m/s.
+  double calcKr(double speed_m_s) const;
+};
+
+/// Coefficients of (8.1) against speed (Table 8.1). JSON:
+/// {"delta_f_unit": "deg", "fit": [{"speed_m_s": 6.0, "c1": ..., "c2_per_deg2": ...}, ...]}
+/// with speeds ascending; Kr = c1 + c2_per_deg2 * delta_f_deg^2.
+struct KrTable {
+  struct Row {
+    double speed_m_s = 0;
+    double c1 = 0;           ///< Kr at delta_f = 0
+    double c2_per_deg2 = 0;  ///< 1/deg^2
+  };
+  std::vector<Row> rows;
+
+  void validate(const std::string& where) const;
+  static KrTable fromParams(const ParamReader& r);
+  static KrTable fromFile(const std::string& path);
+  /// c1 and c2 at a speed: linear interpolation, clamped at the table's ends.
+  Row calcAt(double speed_m_s) const;
+};
+
+/// The rear angle's target and its derivatives (rad, rad/s, rad/s^2) and the
+/// ratio Kr(U, delta_f) = delta_r* / delta_f (its limit at delta_f = 0).
+struct RearSteerTarget {
+  double angle_rad = 0, rate_rad_s = 0, accel_rad_s2 = 0, kr = 0;
+};
+
+class RearSteerStrategy {
+ public:
+  virtual ~RearSteerStrategy() = default;
+  /// "2ws", "linear" or "nonlinear".
+  virtual std::string name() const = 0;
+  /// Target at speed U (m/s) for the front angle delta_f (rad) and its rate
+  /// and acceleration; throws Error if an input is not finite.
+  RearSteerTarget calcTarget(double speed_m_s, double df_rad, double df_rate_rad_s, double df_accel_rad_s2) const;
+
+ protected:
+  virtual RearSteerTarget DoCalcTarget(double U, double df, double dfd, double dfdd) const = 0;
+};
+
+class TwoWsStrategy : public RearSteerStrategy {
+ public:
+  std::string name() const override { return "2ws"; }
+
+ protected:
+  RearSteerTarget DoCalcTarget(double, double, double, double) const override { return {}; }
+};
+
+class LinearKrStrategy : public RearSteerStrategy {
+ public:
+  explicit LinearKrStrategy(const LinearBicycleParams& p);
+  std::string name() const override { return "linear"; }
+
+ protected:
+  RearSteerTarget DoCalcTarget(double U, double df, double dfd, double dfdd) const override;
+
+ private:
+  LinearBicycleParams p_;
+};
+
+class NonlinearKrStrategy : public RearSteerStrategy {
+ public:
+  explicit NonlinearKrStrategy(KrTable table);
+  std::string name() const override { return "nonlinear"; }
+
+ protected:
+  RearSteerTarget DoCalcTarget(double U, double df, double dfd, double dfdd) const override;
+
+ private:
+  KrTable table_;
+};
+
+/// Names accepted by makeRearSteerStrategy: 2ws, linear, nonlinear.
+const std::vector<std::string>& rearSteerStrategyNames();
+/// Throws Error naming `name` and the known ones if unknown, or if
+/// "nonlinear" is asked without a table.
+std::shared_ptr<const RearSteerStrategy> makeRearSteerStrategy(const std::string& name, const LinearBicycleParams& linear,
+                                                               const KrTable* table);
+
+/// Tracking gains of (8.5)/(8.8).
+struct RearSteerParams {
+  double g1_per_s2 = 10;  ///< G1 on delta_r* - delta_r, 1/s^2
+  double g2_per_s = 10;   ///< G2 on delta_r*' - delta_r', 1/s
+  void validate() const;
+  /// Keys g1_per_s2, g2_per_s.
+  static RearSteerParams fromParams(const ParamReader& r);
+};
+
+struct RearSteerEvaluation {
+  double speed_m_s = 0;
+  double front_angle_rad = 0, front_rate_rad_s = 0, front_accel_rad_s2 = 0;
+  RearSteerTarget target;
+  double rear_angle_rad = 0, rear_rate_rad_s = 0;
+  double accel_rad_s2 = 0;  ///< delta_r'' (8.5)/(8.8)
+};
+
+class RearSteerLaw : public SteeringLaw {
+ public:
+  RearSteerLaw(std::string name, std::shared_ptr<const RearSteerStrategy> strategy, const RearSteerParams& params,
+               const SteeringPlugin& front, const SteeringPlugin& rear, const SimTK::MobilizedBody& chassis);
+  RearSteerEvaluation calcEvaluation(const SimTK::State& s) const;
+  const RearSteerStrategy& strategy() const { return *strategy_; }
+
+ protected:
+  double DoCalcAcceleration(const SimTK::State& s) const override { return calcEvaluation(s).accel_rad_s2; }
+
+ private:
+  std::shared_ptr<const RearSteerStrategy> strategy_;
+  RearSteerParams p_;
+  const SteeringPlugin* front_;  // owned by the same scene
+  SimTK::MobilizedBody::Pin rear_;
+  SimTK::MobilizedBody chassis_;
+};
+
+/// Controller plugin: sets a RearSteerLaw on the rear state-driven steering
+/// plugin, reading the front one (which must be state-driven, e.g. by a path
+/// controller). Outputs <name>.kr, <name>.target_rad and
+/// <name>.tracking_error_rad (delta_r - delta_r*).
+class RearSteerPlugin : public ControllerPlugin {
+ public:
+  RearSteerPlugin(std::string name, std::string rearSteering, std::string frontSteering, std::string chassisBody,
+                  std::shared_ptr<const RearSteerStrategy> strategy, const RearSteerParams& params);
+  const RearSteerLaw& law() const;
+
+ protected:
+  void DoAddTo(Scene& scene) override;
+
+ private:
+  std::string rear_, front_, chassis_;
+  std::shared_ptr<const RearSteerStrategy> strategy_;
+  RearSteerParams p_;
+  std::shared_ptr<const RearSteerLaw> law_;
+};
+
+/// Registers "rear_steer": {"rear_steering": "rear_steer", "front_steering":
+/// "front_steer", "chassis": "chassis", "strategy": "linear", "g1_per_s2": 10,
+/// "g2_per_s": 10, "linear_bicycle": {...} (optional, chapter 6 values by
+/// default), "kr_table": "file.json" (nonlinear only)}.
+void registerRearSteerPlugins(PluginRegistry& registry);
+
+}  // namespace vdyn

@@ -1,0 +1,137 @@
+// ch7_closed_loop: the seed's closed-loop path control (section 7.3) on the
+// nonlinear bicycle at constant speed: a lane change (7.6)-(7.8) and a J-turn
+// (7.19)-(7.24) followed by the controller (7.9)-(7.18) with the seed's gains.
+// Writes each run's history (CSV), the reference paths, trajectories against
+// the reference, steering histories and path errors (PNG), and summary.json.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "path_study.h"
+#include "study.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/path_control/path_control.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/vehicles/bicycle.h"
+
+using namespace vdyn;
+
+namespace {
+struct RunResult {
+  std::string name, csv, path_csv;
+  Json summary;
+};
+
+RunResult runOne(const BicycleParams& bp, double U0, const ParamReader& m, const SimulationSettings& base,
+                 const std::string& name, const std::string& out) {
+  const auto path = makeReferencePath(m.child("path"));
+  const PathControlParams gains = PathControlParams::fromParams(m.child("gains"));
+  Bicycle bike(bp);
+  bike.addFrontSteering("front_steer", SteeringStateSpec{});
+  bike.updScene().addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis", path, gains));
+  bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
+  SimTK::State s = bike.makeInitialState(U0);
+  SimulationSettings sim = base;
+  sim.t_end_s = m.number("t_end_s");
+  Recorder rec(bike.getScene(),
+               {"chassis.x_m", "chassis.y_m", "chassis.yaw_rad", "chassis.yaw_rate_rad_s", "chassis.lateral_speed_m_s",
+                "front_steer.angle_rad", "front_steer.command_rad", "front_steer.rate_rad_s",
+                "front_steer.accel_rad_s2", "front_steer.drift_rad", "path_control.e1_m", "path_control.e2",
+                "path_control.e3_m", "path_control.e4", "path_control.path_distance_m"});
+  const RunSummary run = simulate(bike.getScene(), s, sim, &rec, study::progress(name, sim.t_end_s));
+  study::endProgress();
+  RunResult r;
+  r.name = name;
+  r.csv = out + "/" + name + ".csv";
+  r.path_csv = out + "/" + name + "_reference.csv";
+  rec.writeCsv(r.csv);
+  study::writePathCsv(r.path_csv, *path, 10.0, 20.0);
+  const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
+  r.summary = {{"name", name},
+               {"path", m.child("path").json()},
+               {"gains", m.child("gains").json()},
+               {"max_path_error_m", err.max_abs},
+               {"rms_path_error_m", err.rms},
+               {"max_e1_m", study::maxAbs(rec.column("path_control.e1_m"))},
+               {"peak_steer_deg", study::maxAbs(rec.column("front_steer.angle_rad")) * 180 / SimTK::Pi},
+               {"peak_lateral_velocity_m_s", study::maxAbs(rec.column("chassis.lateral_speed_m_s"))},
+               {"final_x_m", rec.column("chassis.x_m").back()},
+               {"final_y_m", rec.column("chassis.y_m").back()},
+               {"final_heading_rad", rec.column("chassis.yaw_rad").back()},
+               {"max_steer_drift_rad", study::maxAbs(rec.column("front_steer.drift_rad"))},
+               {"max_constraint_error", run.max_constraint_error},
+               {"steps", run.steps},
+               {"sim_time_s", run.sim_time_s},
+               {"wall_time_s", run.wall_time_s}};
+  return r;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  return study::run("ch7_closed_loop", [&] {
+    namespace po = study::po;
+    po::options_description opts("Options");
+    opts.add_options()("data", po::value<std::string>()->default_value("ch7_closed_loop.json"), "manoeuvre data file")(
+        "speed-m-s", po::value<double>(), "constant forward speed, m/s (seed: 10)")(
+        "integrator", po::value<std::string>(), "integrator name")("accuracy", po::value<double>(),
+                                                                    "integrator relative accuracy")(
+        "no-plots", "skip the PNG plots");
+    const auto vm = study::parse("ch7_closed_loop",
+                                 "closed-loop lane change and J-turn of the nonlinear bicycle (7.3)", argc, argv, opts);
+    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    const BicycleParams bp = BicycleParams::fromFile(data.string("bicycle_data"));
+    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
+    requirePositive(U0, "--speed-m-s");
+    SimulationSettings base;
+    base.report_interval_s = data.number("report_interval_s");
+    base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
+    if (vm.count("integrator")) base.integrator.method = vm["integrator"].as<std::string>();
+    if (vm.count("accuracy")) base.integrator.accuracy = vm["accuracy"].as<double>();
+    base.integrator.validate();
+    const std::string out = study::outputDir(vm, "ch7_closed_loop");
+    const auto wall0 = std::chrono::steady_clock::now();
+
+    std::vector<RunResult> runs;
+    for (const char* name : {"lane_change", "j_turn"}) runs.push_back(runOne(bp, U0, data.child(name), base, name, out));
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+
+    Json list = Json::array();
+    for (const auto& r : runs) list.push_back(r.summary);
+    study::writeJson(out + "/summary.json", {{"speed_m_s", U0}, {"runs", list}, {"wall_time_s", wall}});
+    if (!vm.count("no-plots")) {
+      std::vector<study::PlotSpec> plots;
+      for (const auto& r : runs) {
+        const std::string fig = r.name == "lane_change" ? "7.8" : "7.11";
+        plots.push_back({out + "/" + r.name + "_trajectory.png",
+                         "Closed-loop " + r.name + ": chassis c.m. path and reference (Fig. " + fig + "a)", "x (m)",
+                         "y (m)",
+                         {{r.path_csv, "x_m", "y_m", "reference"}, {r.csv, "chassis.x_m", "chassis.y_m", "bicycle"}},
+                         r.name == "j_turn"});
+        plots.push_back({out + "/" + r.name + "_steering.png",
+                         "Closed-loop " + r.name + ": front steering angle (Fig. " + fig + "b)", "t (s)",
+                         "steering angle (rad)", {{r.csv, "t_s", "front_steer.angle_rad", "delta_f"}}});
+        plots.push_back({out + "/" + r.name + "_path_error.png",
+                         "Closed-loop " + r.name + ": distance of the c.m. to the reference (+ left)", "t (s)",
+                         "path error (m)", {{r.csv, "t_s", "path_control.path_distance_m", "path error"}}});
+      }
+      study::plot(plots);
+    }
+    std::printf("ch7_closed_loop: nonlinear bicycle at %g m/s, %s at %g\n", U0, base.integrator.method.c_str(),
+                base.integrator.accuracy);
+    std::printf("  %-12s %-22s %11s %11s %10s %12s %11s %7s\n", "run", "K1/K2/K3/K4/K5, dT", "max err m",
+                "rms err m", "steer deg", "peak v_y m/s", "drift rad", "wall s");
+    for (const auto& r : runs) {
+      const Json& j = r.summary;
+      const Json& g = j["gains"];
+      char gains[160];
+      std::snprintf(gains, sizeof gains, "%g/%g/%g/%g/%g, %g", g["k1_rad_per_s2_per_m"].get<double>(),
+                    g["k2_rad_per_s2"].get<double>(), g["k3_rad_per_s2_per_m"].get<double>(),
+                    g["k4_rad_per_s2"].get<double>(), g["k5_per_s"].get<double>(), g["look_ahead_s"].get<double>());
+      std::printf("  %-12s %-22s %11.4f %11.4f %10.3f %12.4f %11.1e %7.2f\n", r.name.c_str(), gains,
+                  j["max_path_error_m"].get<double>(), j["rms_path_error_m"].get<double>(),
+                  j["peak_steer_deg"].get<double>(), j["peak_lateral_velocity_m_s"].get<double>(),
+                  j["max_steer_drift_rad"].get<double>(), j["wall_time_s"].get<double>());
+    }
+    std::printf("  total wall time %.2f s; output %s\n", wall, out.c_str());
+  });
+}

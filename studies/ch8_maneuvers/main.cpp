@@ -1,0 +1,290 @@
+// ch8_maneuvers: the seed's chapter 8 comparison (DESIGN.md section 7): the
+// App. A 4WS vehicle at constant speed follows three lane changes and two
+// J-turns with the path controller (7.9)-(7.18) on the front wheels, under
+// three rear-steer strategies (8.1)-(8.8): 2ws, linear (Kr of the linear
+// bicycle) and nonlinear (Kr = C1 + C2 delta_f^2 from a coefficient table).
+// Per scenario one figure (trajectories against the reference, front and rear
+// steering, Kr, lateral velocity, path error: Figures 8.2-8.17), a CSV per
+// run, and summary.json with key "runs". A run that fails is recorded with
+// completed = false and its reason; the study then exits 1 after writing all.
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "path_study.h"
+#include "study.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/path_control/path_control.h"
+#include "vdyn/rear_steer/rear_steer.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/vehicles/fourws.h"
+
+using namespace vdyn;
+
+namespace {
+const double kDeg = 180 / SimTK::Pi;
+
+struct Scenario {
+  std::string id, description;
+  double speed_m_s = 0, t_end_s = 0;
+  double abort_path_error_m = 2.0;
+  double path_peak_ay = 0;  ///< U^2 times the reference's largest curvature, m/s^2
+  Json path_json;
+  std::shared_ptr<const ReferencePath> path;
+  PathControlParams gains;
+  RearSteerParams rear;
+};
+
+struct RunResult {
+  std::string csv;
+  Json summary;
+};
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream in(s);
+  std::string item;
+  while (std::getline(in, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+RunResult runOne(const FourWsParams& vp, const Scenario& sc, const std::string& strategyName,
+                 const LinearBicycleParams& linear, const KrTable& table, const SimulationSettings& base,
+                 const std::string& out) {
+  RunResult r;
+  r.csv = out + "/" + sc.id + "_" + strategyName + ".csv";
+  r.summary = {{"scenario", sc.id}, {"strategy", strategyName}, {"speed_m_s", sc.speed_m_s}};
+  try {
+    FourWsVehicle car(vp);
+    car.addAxleSteering("front_steer", true, SteeringStateSpec{});
+    car.addAxleSteering("rear_steer", false, SteeringStateSpec{});
+    Scene& scene = car.updScene();
+    scene.addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis", sc.path, sc.gains));
+    scene.addPlugin(std::make_unique<RearSteerPlugin>("rear_control", "rear_steer", "front_steer", "chassis",
+                                                      makeRearSteerStrategy(strategyName, linear, &table), sc.rear));
+    scene.addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", sc.speed_m_s));
+    SimTK::State s = car.makeInitialState(sc.speed_m_s);
+    SimulationSettings sim = base;
+    sim.t_end_s = sc.t_end_s;
+    Recorder rec(car.getScene(),
+                 {"chassis.x_m", "chassis.y_m", "chassis.yaw_rad", "chassis.yaw_rate_rad_s",
+                  "chassis.lateral_speed_m_s", "chassis.roll_rad", "front_steer.angle_rad", "front_steer.command_rad",
+                  "front_steer.rate_rad_s", "front_steer.accel_rad_s2", "front_steer.drift_rad",
+                  "rear_steer.angle_rad", "rear_steer.command_rad", "rear_steer.drift_rad", "rear_control.kr",
+                  "rear_control.target_rad", "rear_control.tracking_error_rad", "path_control.e1_m",
+                  "path_control.e2", "path_control.e3_m", "path_control.e4", "path_control.path_distance_m",
+                  "path_control.lateral_acceleration_m_s2"});
+    // A run that has lost the path is stopped (an unstable loop would crawl on
+    // with ever smaller steps) and recorded as failed.
+    const auto progress = study::progress(sc.id + " " + strategyName, sim.t_end_s);
+    const Scene& scene0 = car.getScene();
+    const double limit = sc.abort_path_error_m;
+    const RunSummary run = simulate(car.getScene(), s, sim, &rec, [&](const SimTK::State& st) {
+      if (progress) progress(st);
+      const double d = scene0.evalOutput("path_control.path_distance_m", st);
+      if (!(std::abs(d) <= limit))
+        throw Error("lost the path: distance " + formatValue(d) + " m beyond abort_path_error_m = " +
+                    formatValue(limit) + " m at t = " + formatValue(st.getTime()) + " s");
+    });
+    study::endProgress();
+    rec.writeCsv(r.csv);
+    const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
+    const auto& kr = rec.column("rear_control.kr");
+    r.summary.update({{"completed", true},
+                      {"peak_lateral_velocity_m_s", study::maxAbs(rec.column("chassis.lateral_speed_m_s"))},
+                      {"max_path_error_m", err.max_abs},
+                      {"rms_path_error_m", err.rms},
+                      {"peak_front_steer_deg", study::maxAbs(rec.column("front_steer.angle_rad")) * kDeg},
+                      {"peak_rear_steer_deg", study::maxAbs(rec.column("rear_steer.angle_rad")) * kDeg},
+                      {"kr_min", *std::min_element(kr.begin(), kr.end())},
+                      {"kr_max", *std::max_element(kr.begin(), kr.end())},
+                      {"peak_roll_deg", study::maxAbs(rec.column("chassis.roll_rad")) * kDeg},
+                      {"peak_lateral_acceleration_m_s2",
+                       study::maxAbs(rec.column("path_control.lateral_acceleration_m_s2"))},
+                      {"max_rear_tracking_error_rad", study::maxAbs(rec.column("rear_control.tracking_error_rad"))},
+                      {"max_steer_drift_rad", std::max(study::maxAbs(rec.column("front_steer.drift_rad")),
+                                                       study::maxAbs(rec.column("rear_steer.drift_rad")))},
+                      {"max_constraint_error", run.max_constraint_error},
+                      {"steps", run.steps},
+                      {"sim_time_s", run.sim_time_s},
+                      {"wall_time_s", run.wall_time_s}});
+  } catch (const std::exception& e) {
+    study::endProgress();
+    std::string msg = e.what();
+    for (auto& c : msg)
+      if (c == '\n') c = ' ';
+    r.summary.update({{"completed", false}, {"reason", msg}});
+    r.csv.clear();
+  }
+  return r;
+}
+
+/// One figure per scenario (Figures 8.2-8.4 and following): trajectories and
+/// reference, front and rear steering (deg), Kr, lateral velocity, path error.
+void plotScenario(const std::string& png, const Scenario& sc, const std::string& refCsv,
+                  const std::vector<std::pair<std::string, std::string>>& runs) {
+  std::ofstream g(png + ".gp");
+  if (!g) throw Error("cannot write '" + png + ".gp'");
+  g << "set terminal pngcairo size 1400,1300 font 'sans,10'\nset output '" << png << "'\n"
+    << "set datafile separator ','\nset grid\nset key noenhanced\n"
+    << "set multiplot layout 3,2 title '" << sc.id << ": " << sc.description << "' noenhanced\n";
+  auto panel = [&](const std::string& title, const std::string& xl, const std::string& yl, const std::string& x,
+                   const std::string& y, bool ref) {
+    g << "set title '" << title << "' noenhanced\nset xlabel '" << xl << "' noenhanced\nset ylabel '" << yl << "' noenhanced\nplot ";
+    bool first = true;
+    if (ref) {
+      g << "'" << refCsv << "' using (column('x_m')):(column('y_m')) with lines lw 3 lc rgb '#bbbbbb' title 'reference'";
+      first = false;
+    }
+    for (const auto& [label, csv] : runs) {
+      g << (first ? "" : ", \\\n     ") << "'" << csv << "' using (" << x << "):(" << y << ") with lines lw 2 title '"
+        << label << "'";
+      first = false;
+    }
+    g << "\n";
+  };
+  panel("trajectory of the chassis c.m.", "x (m)", "y (m)", "column('chassis.x_m')", "column('chassis.y_m')", true);
+  panel("path error (distance to the reference, + left)", "t (s)", "error (m)", "column('t_s')",
+        "column('path_control.path_distance_m')", false);
+  panel("front steering angle", "t (s)", "delta_f (deg)", "column('t_s')", "column('front_steer.angle_rad')*180/pi",
+        false);
+  panel("rear steering angle", "t (s)", "delta_r (deg)", "column('t_s')", "column('rear_steer.angle_rad')*180/pi",
+        false);
+  panel("steering angle ratio Kr", "t (s)", "Kr", "column('t_s')", "column('rear_control.kr')", false);
+  panel("lateral velocity of the chassis (chassis frame)", "t (s)", "v_eta (m/s)", "column('t_s')",
+        "column('chassis.lateral_speed_m_s')", false);
+  g << "unset multiplot\n";
+  g.close();
+  const std::string cmd = "gnuplot '" + png + ".gp' 2> '" + png + ".log'";
+  if (std::system(cmd.c_str()) != 0) throw Error("gnuplot failed on '" + png + ".gp' (see " + png + ".log)");
+  std::remove((png + ".log").c_str());
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  return study::run("ch8_maneuvers", [&] {
+    namespace po = study::po;
+    po::options_description opts("Options");
+    opts.add_options()("data", po::value<std::string>()->default_value("ch8_maneuvers.json"), "manoeuvre data file")(
+        "kr-table", po::value<std::string>(),
+        "Kr coefficient table for the nonlinear strategy (JSON: delta_f_unit deg, fit [{speed_m_s, c1, "
+        "c2_per_deg2}]); default: the data file's kr_table")(
+        "scenario", po::value<std::string>(), "comma-separated scenario ids to run (default: all)")(
+        "strategy", po::value<std::string>(), "comma-separated strategies: 2ws, linear, nonlinear (default: all)")(
+        "integrator", po::value<std::string>(), "integrator name")("accuracy", po::value<double>(),
+                                                                    "integrator relative accuracy")(
+        "no-plots", "skip the PNG plots");
+    const auto vm = study::parse("ch8_maneuvers",
+                                 "lane changes and J-turns of the 4WS vehicle under three rear-steer strategies (ch. 8)",
+                                 argc, argv, opts);
+    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    const FourWsParams vp = FourWsParams::fromFile(data.string("vehicle_data"));
+    const std::string tablePath = vm.count("kr-table") ? vm["kr-table"].as<std::string>() : data.string("kr_table");
+    const KrTable table = KrTable::fromFile(tablePath);
+    const LinearBicycleParams linear = LinearBicycleParams::fromParams(data.child("linear_bicycle"));
+    const RearSteerParams rearDefault = RearSteerParams::fromParams(data.child("rear_steer_gains"));
+    SimulationSettings base;
+    base.report_interval_s = data.number("report_interval_s");
+    base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
+    if (vm.count("integrator")) base.integrator.method = vm["integrator"].as<std::string>();
+    if (vm.count("accuracy")) base.integrator.accuracy = vm["accuracy"].as<double>();
+    base.integrator.validate();
+
+    std::vector<Scenario> scenarios;
+    for (const ParamReader& r : data.array("scenarios")) {
+      Scenario sc;
+      sc.id = r.string("id");
+      sc.description = r.string("description");
+      sc.speed_m_s = requirePositive(r.number("speed_m_s"), r.at("speed_m_s"));
+      sc.t_end_s = requirePositive(r.number("t_end_s"), r.at("t_end_s"));
+      sc.abort_path_error_m = requirePositive(data.number("abort_path_error_m"), data.at("abort_path_error_m"));
+      sc.path_json = r.child("path").json();
+      sc.path = makeReferencePath(r.child("path"));
+      sc.gains = PathControlParams::fromParams(r.child("gains"));
+      for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
+        sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
+      sc.rear = r.has("rear_steer_gains") ? RearSteerParams::fromParams(r.child("rear_steer_gains")) : rearDefault;
+      scenarios.push_back(sc);
+    }
+    if (vm.count("scenario")) {
+      std::vector<Scenario> chosen;
+      for (const auto& id : splitList(vm["scenario"].as<std::string>())) {
+        auto it = std::find_if(scenarios.begin(), scenarios.end(), [&](const Scenario& s) { return s.id == id; });
+        if (it == scenarios.end()) {
+          std::string known;
+          for (const auto& s : scenarios) known += (known.empty() ? "" : ", ") + s.id;
+          throw Error("--scenario: unknown scenario '" + id + "'; known: " + known);
+        }
+        chosen.push_back(*it);
+      }
+      scenarios = chosen;
+    }
+    std::vector<std::string> strategies = rearSteerStrategyNames();
+    if (vm.count("strategy")) {
+      strategies = splitList(vm["strategy"].as<std::string>());
+      for (const auto& st : strategies) makeRearSteerStrategy(st, linear, &table);  // validates the name
+    }
+    const std::string out = study::outputDir(vm, "ch8_maneuvers");
+    const auto wall0 = std::chrono::steady_clock::now();
+
+    Json runs = Json::array();
+    int failed = 0;
+    for (const Scenario& sc : scenarios) {
+      const std::string refCsv = out + "/" + sc.id + "_reference.csv";
+      study::writePathCsv(refCsv, *sc.path, sc.speed_m_s * 1.0, sc.speed_m_s * 2.0);
+      std::vector<std::pair<std::string, std::string>> csvs;
+      for (const auto& st : strategies) {
+        RunResult r = runOne(vp, sc, st, linear, table, base, out);
+        r.summary["path"] = sc.path_json;
+        r.summary["path_peak_lateral_acceleration_m_s2"] = sc.path_peak_ay;
+        r.summary["gains"] = {{"k1_rad_per_s2_per_m", sc.gains.k1_rad_per_s2_per_m},
+                              {"k2_rad_per_s2", sc.gains.k2_rad_per_s2},
+                              {"k3_rad_per_s2_per_m", sc.gains.k3_rad_per_s2_per_m},
+                              {"k4_rad_per_s2", sc.gains.k4_rad_per_s2},
+                              {"k5_per_s", sc.gains.k5_per_s},
+                              {"look_ahead_s", sc.gains.look_ahead_s},
+                              {"acceleration_lag_s", sc.gains.acceleration_lag_s},
+                              {"g1_per_s2", sc.rear.g1_per_s2},
+                              {"g2_per_s", sc.rear.g2_per_s}};
+        if (r.summary["completed"].get<bool>()) {
+          csvs.push_back({st, r.csv});
+        } else {
+          ++failed;
+        }
+        runs.push_back(r.summary);
+      }
+      if (!vm.count("no-plots") && !csvs.empty()) plotScenario(out + "/" + sc.id + ".png", sc, refCsv, csvs);
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    study::writeJson(out + "/summary.json",
+                     {{"runs", runs}, {"kr_table", tablePath}, {"integrator", base.integrator.method},
+                      {"accuracy", base.integrator.accuracy}, {"wall_time_s", wall}});
+
+    std::printf("ch8_maneuvers: 4WS vehicle, %s at %g, Kr table %s\n", base.integrator.method.c_str(),
+                base.integrator.accuracy, tablePath.c_str());
+    std::printf("  %-5s %-9s %6s %12s %10s %10s %9s %9s %13s %15s %7s\n", "scen", "strategy", "U m/s", "peak v_y m/s",
+                "max err m", "rms err m", "front deg", "rear deg", "Kr min..max", "a_y path/car", "wall s");
+    for (const Json& j : runs) {
+      if (!j["completed"].get<bool>()) {
+        std::printf("  %-5s %-9s FAILED: %s\n", j["scenario"].get<std::string>().c_str(),
+                    j["strategy"].get<std::string>().c_str(), j["reason"].get<std::string>().c_str());
+        continue;
+      }
+      const double me = j["max_path_error_m"].get<double>(), re = j["rms_path_error_m"].get<double>();
+      std::printf("  %-5s %-9s %6.1f %12.4f %10.4f %10.4f %9.3f %9.3f %6.3f..%-6.3f %7.2f/%-7.2f %7.2f%s\n",
+                  j["scenario"].get<std::string>().c_str(), j["strategy"].get<std::string>().c_str(),
+                  j["speed_m_s"].get<double>(), j["peak_lateral_velocity_m_s"].get<double>(), me, re,
+                  j["peak_front_steer_deg"].get<double>(), j["peak_rear_steer_deg"].get<double>(),
+                  j["kr_min"].get<double>(), j["kr_max"].get<double>(),
+                  j["path_peak_lateral_acceleration_m_s2"].get<double>(),
+                  j["peak_lateral_acceleration_m_s2"].get<double>(), j["wall_time_s"].get<double>(),
+                  (me <= 0.10 && re <= 0.03) ? "" : "  (above the 0.10 / 0.03 m bar)");
+    }
+    std::printf("  total wall time %.1f s; output %s\n", wall, out.c_str());
+    if (failed) throw Error(std::to_string(failed) + " of " + std::to_string(runs.size()) +
+                            " runs failed (see summary.json)");
+  });
+}

@@ -1,0 +1,327 @@
+// State-driven steering, the path controller (7.9)-(7.18) and the rear-steer
+// strategies (8.1)-(8.8): closed forms, formulas and named errors.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/path_control/path_control.h"
+#include "vdyn/plugins/builtin.h"
+#include "vdyn/rear_steer/rear_steer.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/vehicles/bicycle.h"
+#include "vdyn/vehicles/fourws.h"
+
+using namespace vdyn;
+using SimTK::Vec2;
+
+namespace {
+/// delta'' = c (a closed form: delta = c t^2 / 2 from rest).
+class ConstantLaw : public SteeringLaw {
+ public:
+  explicit ConstantLaw(double c) : SteeringLaw("constant"), c_(c) {}
+
+ protected:
+  double DoCalcAcceleration(const SimTK::State&) const override { return c_; }
+
+ private:
+  double c_;
+};
+
+/// The straight line Y = y0 (a lane change with no shift).
+std::shared_ptr<const ReferencePath> straightLine(double y0) {
+  LaneChangeParams p;
+  p.start_y_m = y0;
+  p.length_m = 10;
+  p.shift_m = 0;
+  return std::make_shared<LaneChangePath>(p);
+}
+
+PathControlParams gains(double k1, double k2, double k3, double k4, double k5, double dT) {
+  PathControlParams g;
+  g.k1_rad_per_s2_per_m = k1;
+  g.k2_rad_per_s2 = k2;
+  g.k3_rad_per_s2_per_m = k3;
+  g.k4_rad_per_s2 = k4;
+  g.k5_per_s = k5;
+  g.look_ahead_s = dT;
+  return g;
+}
+
+struct ControlledBicycle {
+  std::unique_ptr<Bicycle> bike;
+  const PathControlPlugin* control = nullptr;
+};
+
+ControlledBicycle controlledBicycle(std::shared_ptr<const ReferencePath> path, const PathControlParams& g) {
+  ControlledBicycle c;
+  c.bike = std::make_unique<Bicycle>(BicycleParams::fromFile("bicycle.json"));
+  c.bike->addFrontSteering("front_steer", SteeringStateSpec{});
+  c.control = &static_cast<const PathControlPlugin&>(c.bike->updScene().addPlugin(
+      std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis", std::move(path), g)));
+  c.bike->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
+  return c;
+}
+}  // namespace
+
+// --- state-driven steering ---------------------------------------------------
+TEST(SteeringState, AngleFollowsTheIntegratedLawWithoutDrift) {
+  Bicycle bike(BicycleParams::fromFile("bicycle.json"));
+  SteeringPlugin& steer = bike.addFrontSteering("front_steer", SteeringStateSpec{});
+  const double c = 0.08;  // rad/s^2
+  steer.setAccelerationLaw(std::make_shared<ConstantLaw>(c));
+  bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
+  SimTK::State s = bike.makeInitialState(10.0);
+  // The steer body adds one prescribed mobility: 9 + 1 mobilities, 1 + 1 constraints.
+  EXPECT_EQ(s.getNU(), 10);
+  EXPECT_EQ(bike.degreesOfFreedom(s), 7);  // 9 - steering - speed hold, as with a time command
+  SimulationSettings sim;
+  sim.t_end_s = 1.0;
+  Recorder rec(bike.getScene(), {"front_steer.angle_rad", "front_steer.command_rad", "front_steer.rate_rad_s",
+                                 "front_steer.drift_rad"});
+  simulate(bike.getScene(), s, sim, &rec);
+  double drift = 0, err = 0;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const double t = rec.time()[i];
+    drift = std::max(drift, std::abs(rec.column("front_steer.drift_rad")[i]));
+    err = std::max(err, std::abs(rec.column("front_steer.angle_rad")[i] - c * t * t / 2));
+    EXPECT_NEAR(rec.column("front_steer.rate_rad_s")[i], c * t, 1e-9) << "t = " << t;
+  }
+  std::printf("wheel angle against c t^2 / 2: %.2e rad; wheel angle against its state (drift): %.2e rad\n", err, drift);
+  EXPECT_LE(err, 1e-8);
+  EXPECT_LE(drift, 1e-9);
+}
+
+TEST(SteeringState, ErrorsAreNamed) {
+  Bicycle bike(BicycleParams::fromFile("bicycle.json"));
+  bike.addFrontSteering("front_steer", SteeringStateSpec{});
+  EXPECT_EQ(test::errorOf([&] { bike.makeInitialState(10.0); }),
+            "steering plugin 'front_steer' is state-driven but no controller set its acceleration law");
+  Bicycle timed(BicycleParams::fromFile("bicycle.json"));
+  timed.addFrontSteering("front_steer", std::make_shared<HoldCommand>(0.0));
+  EXPECT_EQ(test::errorOf([&] {
+              timed.updScene().addPlugin(std::make_unique<PathControlPlugin>(
+                  "path_control", "front_steer", "chassis", straightLine(0), gains(1, 1, 1, 1, 1, 0.5)));
+            }),
+            "path control plugin 'path_control': steering plugin 'front_steer' follows a time command; the "
+            "controller needs a state-driven one");
+  EXPECT_EQ(test::errorOf([&] {
+              timed.updScene().addPlugin(std::make_unique<PathControlPlugin>(
+                  "path_control", "rear_steer", "chassis", straightLine(0), gains(1, 1, 1, 1, 1, 0.5)));
+            }),
+            "path control plugin 'path_control': the scene has no steering plugin 'rear_steer'");
+  EXPECT_EQ(test::errorOf([] { gains(1, -2, 1, 1, 1, 0.5).validate(); }),
+            "path control k2_rad_per_s2 must not be negative, got -2");
+}
+
+// --- path controller ---------------------------------------------------------
+TEST(PathControl, ZeroGainsGiveZeroCommandAndEachGainItsTerm) {
+  const auto path = straightLine(0.5);  // the vehicle starts 0.5 m right of it
+  {
+    ControlledBicycle c = controlledBicycle(path, gains(0, 0, 0, 0, 0, 0.6));
+    SimTK::State s = c.bike->makeInitialState(10.0);
+    EXPECT_NEAR(c.bike->getScene().evalOutput("path_control.e1_m", s), -0.5, 1e-12);
+    EXPECT_EQ(c.bike->getScene().evalOutput("front_steer.accel_rad_s2", s), 0.0);
+    SimulationSettings sim;
+    sim.t_end_s = 0.5;
+    simulate(c.bike->getScene(), s, sim);
+    EXPECT_EQ(c.bike->getScene().evalOutput("front_steer.command_rad", s), 0.0);  // never steered
+  }
+  // Only K1: delta'' = -K1 e1 (7.11); only K3 (no acceleration term): -K3 e3 at
+  // the point predicted dT ahead (7.13)-(7.14) with x'' = 0; only K2: -K2 e2.
+  PathControlParams g1 = gains(7, 0, 0, 0, 0, 0.6), g3 = gains(0, 0, 5, 0, 0, 0.5), g2 = gains(0, 3, 0, 0, 0, 0.6);
+  g3.acceleration_estimate = "none";
+  const LaneChangeParams lp{0.0, 0.0, 30.0, 2.0};
+  const auto lane = std::make_shared<LaneChangePath>(lp);
+  for (const auto& [g, which] : {std::pair{g1, 1}, std::pair{g3, 3}, std::pair{g2, 2}}) {
+    ControlledBicycle c = controlledBicycle(lane, g);
+    SimTK::State s = c.bike->makeInitialState(10.0);
+    SimulationSettings sim;
+    sim.t_end_s = 1.2;  // inside the lane change, off the path, moving
+    simulate(c.bike->getScene(), s, sim);
+    c.bike->getScene().getSystem().realize(s, SimTK::Stage::Velocity);
+    const SimTK::Vec3 p = c.bike->chassis().getBodyOriginLocation(s), v = c.bike->chassis().getBodyOriginVelocity(s);
+    const Vec2 p2(p[0], p[1]), v2(v[0], v[1]);
+    const double steerRate = c.bike->getScene().evalOutput("front_steer.rate_rad_s", s);
+    double expected = 0;
+    if (which == 1) expected = -7 * (p[1] - lane->calcY(p[0]));
+    if (which == 2) expected = -3 * (v[1] / v[0] - lane->calcSlope(p[0]));
+    if (which == 3) expected = -5 * lane->calcErrors(p2 + 0.5 * v2, v2).position_m;
+    EXPECT_NE(expected, 0.0);
+    EXPECT_NEAR(c.bike->getScene().evalOutput("front_steer.accel_rad_s2", s), expected, 1e-12 * std::abs(expected))
+        << "gain K" << which;
+    EXPECT_EQ(steerRate, c.bike->getScene().evalOutput("front_steer.rate_rad_s", s));
+  }
+}
+
+TEST(PathControl, SteersBackToAStraightPathFromALateralOffset) {
+  PathControlParams g = gains(10, 2, 100, 5, 10, 0.6);  // the seed's lane-change gains
+  g.tracked_point_m = SimTK::Vec3(0, 0, -0.59);          // ground level (ch7_closed_loop.json)
+  ControlledBicycle c = controlledBicycle(straightLine(0.5), g);
+  SimTK::State s = c.bike->makeInitialState(10.0);
+  SimulationSettings sim;
+  sim.t_end_s = 6.0;
+  Recorder rec(c.bike->getScene(), {"path_control.e1_m", "path_control.e2", "front_steer.angle_rad",
+                                    "front_steer.drift_rad", "path_control.path_distance_m"});
+  simulate(c.bike->getScene(), s, sim, &rec);
+  const auto& e1 = rec.column("path_control.e1_m");
+  double firstSteer = 0, drift = 0, overshoot = 0;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    if (firstSteer == 0 && std::abs(rec.column("front_steer.angle_rad")[i]) > 1e-4)
+      firstSteer = rec.column("front_steer.angle_rad")[i];
+    drift = std::max(drift, std::abs(rec.column("front_steer.drift_rad")[i]));
+    overshoot = std::max(overshoot, e1[i]);
+    EXPECT_NEAR(rec.column("path_control.path_distance_m")[i], e1[i], 1e-12);  // a straight path: the same
+  }
+  std::printf("from -0.5 m: e1 after 6 s %.2e m, heading error %.2e, overshoot %.3f m, steering drift %.1e rad\n",
+              e1.back(), rec.column("path_control.e2").back(), overshoot, drift);
+  EXPECT_GT(firstSteer, 0.0);  // right of the path: steers left first
+  EXPECT_LE(std::abs(e1.back()), 0.01);
+  EXPECT_LE(std::abs(rec.column("path_control.e2").back()), 1e-3);
+  EXPECT_LE(overshoot, 0.1);
+  EXPECT_LE(drift, 1e-9);
+}
+
+// --- rear-steer strategies ---------------------------------------------------
+TEST(RearSteer, LinearBicycleRatio) {
+  const LinearBicycleParams p;  // chapter 6: M 1024 kg, a 1.305 m, b 0.965 m, C 1.4e5 N/rad per axle
+  const double l = 2.27, U = 20;
+  EXPECT_NEAR(p.calcKr(U), (-0.965 + 1024 * 1.305 * U * U / (1.4e5 * l)) / (1.305 + 1024 * 0.965 * U * U / (1.4e5 * l)),
+              1e-15);
+  EXPECT_NEAR(p.calcKr(0.0), -0.965 / 1.305, 1e-15);  // kinematic contra phase at rest: -b / a
+  // Zero where M a U^2 = b C_ar l: 15.15 m/s.
+  const double U0 = std::sqrt(0.965 * 1.4e5 * l / (1024 * 1.305));
+  EXPECT_NEAR(p.calcKr(U0), 0.0, 1e-15);
+  EXPECT_NEAR(U0, 15.149, 0.001);
+}
+
+TEST(RearSteer, TableInterpolatesInSpeedAndClamps) {
+  const KrTable t = KrTable::fromParams(ParamReader::fromJson(
+      {{"delta_f_unit", "deg"},
+       {"fit", {{{"speed_m_s", 10}, {"c1", -0.2}, {"c2_per_deg2", 0.01}},
+                {{"speed_m_s", 20}, {"c1", 0.3}, {"c2_per_deg2", 0.03}}}}},
+      "kr.json"));
+  EXPECT_NEAR(t.calcAt(12.5).c1, -0.2 + 0.25 * 0.5, 1e-15);
+  EXPECT_NEAR(t.calcAt(12.5).c2_per_deg2, 0.015, 1e-15);
+  EXPECT_EQ(t.calcAt(5).c1, -0.2);
+  EXPECT_EQ(t.calcAt(40).c2_per_deg2, 0.03);
+  EXPECT_EQ(test::errorOf([] {
+              KrTable::fromParams(ParamReader::fromJson(
+                  {{"delta_f_unit", "deg"},
+                   {"fit", {{{"speed_m_s", 20}, {"c1", 0}, {"c2_per_deg2", 0}}, {{"speed_m_s", 10}, {"c1", 0}, {"c2_per_deg2", 0}}}}},
+                  "kr.json"));
+            }),
+            "kr.json: fit[1].speed_m_s: speeds must be ascending, got 10 after 20");
+  EXPECT_EQ(test::errorOf([] {
+              KrTable::fromParams(ParamReader::fromJson({{"delta_f_unit", "rad"}, {"fit", Json::array()}}, "kr.json"));
+            }),
+            "kr.json: delta_f_unit: must be \"deg\", got \"rad\"");
+  EXPECT_EQ(test::errorOf([] { makeRearSteerStrategy("4ws", LinearBicycleParams{}, nullptr); }),
+            "unknown rear steer strategy '4ws'; known: 2ws, linear, nonlinear");
+  EXPECT_EQ(test::errorOf([] { makeRearSteerStrategy("nonlinear", LinearBicycleParams{}, nullptr); }),
+            "rear steer strategy 'nonlinear' needs a Kr coefficient table");
+}
+
+TEST(RearSteer, NonlinearTargetDerivativesMatchFiniteDifferences) {
+  KrTable t;
+  t.rows = {{16.0, 0.05, 0.004}};
+  const NonlinearKrStrategy st(t);
+  // delta_f(t) = 0.08 sin(3 t): (8.6)-(8.8) against central differences.
+  auto df = [](double x) { return 0.08 * std::sin(3 * x); };
+  auto dfd = [](double x) { return 0.24 * std::cos(3 * x); };
+  auto dfdd = [](double x) { return -0.72 * std::sin(3 * x); };
+  auto target = [&](double x) { return st.calcTarget(16.0, df(x), dfd(x), dfdd(x)); };
+  const double h = 1e-5;
+  for (double x = 0.1; x < 2.0; x += 0.173) {
+    const RearSteerTarget r = target(x);
+    const double degF = df(x) * 180 / SimTK::Pi;
+    EXPECT_NEAR(r.kr, 0.05 + 0.004 * degF * degF, 1e-14);               // (8.1)
+    EXPECT_NEAR(r.angle_rad, r.kr * df(x), 1e-15);                      // (8.6)
+    EXPECT_NEAR(r.rate_rad_s, (target(x + h).angle_rad - target(x - h).angle_rad) / (2 * h), 1e-8);
+    EXPECT_NEAR(r.accel_rad_s2, (target(x + h).rate_rad_s - target(x - h).rate_rad_s) / (2 * h), 1e-7);
+  }
+  EXPECT_EQ(TwoWsStrategy().calcTarget(16, 0.1, 0.2, 0.3).angle_rad, 0.0);
+}
+
+namespace {
+/// 4WS at 16 m/s with the path controller on a 2 m lane change, the rear axle
+/// starting 0.01 rad off its target under `strategy`; returns the tracking
+/// error delta_r - Kr delta_f against the closed form of (8.5):
+/// e'' + G2 e' + G1 e = 0 from e(0) = e0, e'(0) = 0.
+double rearTrackingMismatch(const std::shared_ptr<const RearSteerStrategy>& strategy, double& kr) {
+  FourWsVehicle car(FourWsParams::fromFile("appendix_a.json"));
+  car.addAxleSteering("front_steer", true, SteeringStateSpec{});
+  SteeringStateSpec rearStart;
+  const double e0 = 0.01;
+  rearStart.initial_angle_rad = e0;
+  car.addAxleSteering("rear_steer", false, rearStart);
+  const LaneChangeParams lp{5.0, 0.0, 40.0, 2.0};
+  Scene& sc = car.updScene();
+  sc.addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis",
+                                                   std::make_shared<LaneChangePath>(lp), gains(10, 2, 100, 5, 30, 0.6)));
+  RearSteerParams g;  // G1 = G2 = 10
+  sc.addPlugin(std::make_unique<RearSteerPlugin>("rear_control", "rear_steer", "front_steer", "chassis", strategy, g));
+  sc.addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 16.0));
+  SimTK::State s = car.makeInitialState(16.0);
+  SimulationSettings sim;
+  sim.t_end_s = 1.5;
+  sim.integrator.accuracy = 1e-7;
+  Recorder rec(car.getScene(), {"rear_control.tracking_error_rad", "rear_control.kr", "front_steer.angle_rad",
+                                "rear_steer.angle_rad"});
+  simulate(car.getScene(), s, sim, &rec);
+  // Roots of s^2 + 10 s + 10: -5 -+ sqrt(15).
+  const double r1 = -5 + std::sqrt(15.0), r2 = -5 - std::sqrt(15.0);
+  double worst = 0;
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    const double t = rec.time()[i];
+    const double closed = e0 * (r2 * std::exp(r1 * t) - r1 * std::exp(r2 * t)) / (r2 - r1);
+    worst = std::max(worst, std::abs(rec.column("rear_control.tracking_error_rad")[i] - closed));
+  }
+  kr = rec.column("rear_control.kr").back();
+  const double df = rec.column("front_steer.angle_rad").back(), dr = rec.column("rear_steer.angle_rad").back();
+  std::printf("%s: delta_f %.4f rad, delta_r %.5f rad, Kr %.4f; tracking error against the closed form: %.1e rad\n",
+              strategy->name().c_str(), df, dr, kr, worst);
+  EXPECT_GT(std::abs(df), 0.002);  // the front is steering
+  return worst;
+}
+}  // namespace
+
+TEST(RearSteer, TrackingErrorDecaysAsTheG1G2ClosedForm) {
+  double kr = 0;
+  EXPECT_LE(rearTrackingMismatch(std::make_shared<LinearKrStrategy>(LinearBicycleParams{}), kr), 1e-6);
+  // Kr at the measured horizontal speed of the chassis (16 m/s held in the
+  // chassis frame, so pitch leaves it 1e-5 off).
+  EXPECT_NEAR(kr, LinearBicycleParams{}.calcKr(16.0), 1e-4);
+  KrTable t;
+  t.rows = {{12.0, -0.1, 0.002}, {20.0, 0.3, 0.006}};
+  EXPECT_LE(rearTrackingMismatch(std::make_shared<NonlinearKrStrategy>(t), kr), 1e-6);
+  EXPECT_GT(kr, 0.1);  // c1(16) = 0.1 plus c2 delta_f^2 > 0
+}
+
+TEST(RearSteer, ControllersComeFromTheRegistryWithNamedErrors) {
+  const PluginRegistry& reg = builtinPlugins();
+  EXPECT_TRUE(reg.has(PluginKind::Controller, "path_control"));
+  EXPECT_TRUE(reg.has(PluginKind::Controller, "rear_steer"));
+  const Json rear = {{"rear_steering", "rear_steer"}, {"front_steering", "front_steer"}, {"chassis", "chassis"},
+                     {"strategy", "sideways"}, {"g1_per_s2", 10}, {"g2_per_s", 10}};
+  EXPECT_EQ(test::errorOf([&] {
+              reg.create(PluginKind::Controller, "rear_steer", {"rear_control", ParamReader::fromJson(rear, "scene.json")},
+                         "scene.json controllers[1]");
+            }),
+            "unknown rear steer strategy 'sideways'; known: 2ws, linear, nonlinear");
+  // A path controller from its data-file form drives a bicycle like the C++ one.
+  Bicycle bike(BicycleParams::fromFile("bicycle.json"));
+  bike.addFrontSteering("front_steer", SteeringStateSpec{});
+  const Json pc = {{"steering", "front_steer"},
+                   {"chassis", "chassis"},
+                   {"path", {{"type", "lane_change"}, {"start_y_m", 0.5}, {"length_m", 10}, {"shift_m", 0}}},
+                   {"gains",
+                    {{"k1_rad_per_s2_per_m", 7}, {"k2_rad_per_s2", 0}, {"k3_rad_per_s2_per_m", 0}, {"k4_rad_per_s2", 0},
+                     {"k5_per_s", 0}, {"look_ahead_s", 0.6}}}};
+  bike.updScene().addPlugin(reg.create(PluginKind::Controller, "path_control",
+                                       {"path_control", ParamReader::fromJson(pc, "scene.json")}, "scene.json"));
+  const SimTK::State s = bike.makeInitialState(10.0);
+  EXPECT_NEAR(bike.getScene().evalOutput("front_steer.accel_rad_s2", s), -7 * -0.5, 1e-12);  // -K1 e1
+}
