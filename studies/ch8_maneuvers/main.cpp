@@ -176,6 +176,9 @@ int main(int argc, char** argv) {
         "strategy", po::value<std::string>(), "comma-separated strategies: 2ws, linear, nonlinear (default: all)")(
         "integrator", po::value<std::string>(), "integrator name")("accuracy", po::value<double>(),
                                                                     "integrator relative accuracy")(
+        "lane-change-length", po::value<std::string>(),
+        "how the seed's lane-change distance reads: 'full' (DESIGN.md: the whole lane change, X_f - X_0) or "
+        "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
         "no-plots", "skip the PNG plots");
     const auto vm = study::parse("ch8_maneuvers",
                                  "lane changes and J-turns of the 4WS vehicle under three rear-steer strategies (ch. 8)",
@@ -193,6 +196,10 @@ int main(int argc, char** argv) {
     if (vm.count("accuracy")) base.integrator.accuracy = vm["accuracy"].as<double>();
     base.integrator.validate();
 
+    const std::string reading = vm.count("lane-change-length") ? vm["lane-change-length"].as<std::string>()
+                                                                 : data.stringOr("lane_change_length", "full");
+    if (reading != "full" && reading != "half")
+      throw Error("--lane-change-length must be 'full' or 'half', got '" + reading + "'");
     std::vector<Scenario> scenarios;
     for (const ParamReader& r : data.array("scenarios")) {
       Scenario sc;
@@ -202,7 +209,13 @@ int main(int argc, char** argv) {
       sc.t_end_s = requirePositive(r.number("t_end_s"), r.at("t_end_s"));
       sc.abort_path_error_m = requirePositive(data.number("abort_path_error_m"), data.at("abort_path_error_m"));
       sc.path_json = r.child("path").json();
-      sc.path = makeReferencePath(r.child("path"));
+      if (reading == "half" && sc.path_json.value("type", "") == "lane_change") {
+        // The seed's distance is each half: the lane change spans twice it.
+        const double length = sc.path_json.at("length_m").get<double>();
+        sc.path_json["length_m"] = 2 * length;
+        sc.t_end_s += length / sc.speed_m_s;
+      }
+      sc.path = makeReferencePath(ParamReader::fromJson(sc.path_json, r.at("path")));
       sc.gains = PathControlParams::fromParams(r.child("gains"));
       for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
         sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
