@@ -53,8 +53,27 @@ std::vector<double> parseList(const std::string& text, const std::string& what) 
   return v;
 }
 
+/// Front angles from `min` by `step`, the step doubling at `doubling` and at
+/// each doubling of it (0: constant step), up to `max`, deg.
+std::vector<double> makeGrid(double min, double step, double max, double doubling) {
+  std::vector<double> g;
+  double threshold = doubling;
+  for (double d = min; d <= max + 1e-9 * step;) {
+    g.push_back(d);
+    if (doubling > 0 && d >= threshold - 1e-9 * step) {
+      step *= 2;
+      threshold *= 2;
+    }
+    d += step;
+  }
+  return g;
+}
+
 struct SpeedRun {
   double speed_m_s = 0;
+  std::vector<double> front_deg;        // the grid (refined where the branch ends early)
+  int passes = 0;                       // 2 when refined
+  int extra_solves = 0, extra_newton = 0;  // of the first pass, when refined
   std::vector<OptimalRatioPoint> points;
   std::vector<double> yaw_rate_rad_s;   // per point (NaN without a state)
   double wall_time_s = 0;
@@ -73,11 +92,16 @@ int main(int argc, char** argv) {
         "speeds-m-s", po::value<std::string>()->default_value("6,12,16,20,25,30"), "map speeds, m/s, comma separated")(
         "front-min-deg", po::value<double>()->default_value(0.25), "smallest front angle, deg")(
         "front-step-deg", po::value<double>()->default_value(0.25), "front angle step, deg")(
-        "front-max-deg", po::value<double>()->default_value(6.0), "largest front angle tried, deg")(
+        "front-max-deg", po::value<double>()->default_value(40.0), "largest front angle tried, deg")(
+        "front-step-doubling-deg", po::value<double>()->default_value(4.0),
+        "the angle step doubles here and at each doubling of this angle (4, 8, 16, 32 deg), deg; 0: constant step")(
+        "min-points", po::value<int>()->default_value(10),
+        "a speed whose branch ends with fewer map points is redone with a finer step up to its last point")(
         "threads", po::value<int>()->default_value(0), "worker threads (0: one per core)")(
         "fresh-jacobian", "fresh finite-difference Jacobian at every steady-state solve (default: Broyden reuse)")(
         "table-copy", po::value<std::string>(),
         "also write the coefficient table with a provenance comment to this path (e.g. vehicles/data/kr_table.json)")(
+        "no-stability", "admit every converged steady state (skip the stability verdict)")(
         "no-plots", "skip the PNG plots");
     const auto vm = study::parse("ch6_steering_ratio", "optimal 4WS steering ratio: linear law, nonlinear map, fit",
                                  argc, argv, opts);
@@ -91,10 +115,10 @@ int main(int argc, char** argv) {
     if (threads < 0) throw Error("--threads must be non-negative, got " + std::to_string(threads));
     if (threads == 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
     threads = std::min<int>(threads, int(speeds.size()));
-    std::vector<double> frontsDeg;
-    for (int i = 0; fmin + i * fstep <= fmax + 1e-9 * fstep; ++i) frontsDeg.push_back(fmin + i * fstep);
-    std::vector<double> frontsRad;
-    for (double d : frontsDeg) frontsRad.push_back(d * kDeg);
+    const double doubling = requireNonNegative(vm["front-step-doubling-deg"].as<double>(), "--front-step-doubling-deg");
+    const int minPoints = vm["min-points"].as<int>();
+    if (minPoints < 2) throw Error("--min-points must be at least 2, got " + std::to_string(minPoints));
+    const std::vector<double> frontsDeg = makeGrid(fmin, fstep, fmax, doubling);
     const std::string out = study::outputDir(vm, "ch6_steering_ratio");
     const auto t0 = std::chrono::steady_clock::now();
 
@@ -122,6 +146,8 @@ int main(int argc, char** argv) {
     const FourWsParams params = FourWsParams::fromFile(vm["data"].as<std::string>());
     SteadyStateOptions sso;
     sso.fresh_jacobian_each_solve = vm.count("fresh-jacobian") > 0;
+    OptimalRatioOptions oro;
+    oro.check_stability = vm.count("no-stability") == 0;
     std::vector<SpeedRun> runs(speeds.size());
     std::atomic<std::size_t> next{0};
     std::mutex buildMutex;
@@ -156,7 +182,40 @@ int main(int argc, char** argv) {
           };
           const SideSlipOf slip = [&](const SimTK::State& s) { return sc.evalOutput("chassis.side_slip_rad", s); };
           const double kr0 = std::clamp(calcLinearOptimalRatio(lin, U), -1.0, 1.0);
-          run.points = followOptimalRatio(solver, straight, frontsRad, kr0, steer, slip);
+          auto follow = [&](const std::vector<double>& deg) {
+            std::vector<double> rad;
+            for (double d : deg) rad.push_back(d * kDeg);
+            run.front_deg = deg;
+            run.points = followOptimalRatio(solver, straight, rad, kr0, steer, slip, oro);
+            ++run.passes;
+          };
+          // Grid: where the linear bicycle at zero side slip reaches the friction
+          // limit (a_y = mu_max g; from (6.5)-(6.9): delta_f (1 - Kr) = a_y (l + K U^2) / U^2)
+          // within minPoints steps, the step is cut so the branch gets about
+          // minPoints angles (high speed); else the base grid.
+          std::vector<double> grid = frontsDeg;
+          {
+            const double ay = params.tire.mu_max * params.gravity_m_per_s2, klin = calcLinearOptimalRatio(lin, U);
+            const double lim = ay * (lin.wheelbase_m() + lin.understeerGradient() * U * U) / (U * U * (1 - klin)) / kDeg;
+            if (klin < 1 && lim > 0 && 0.8 * lim < fmin + (minPoints - 1) * fstep) {
+              const double step = std::max(0.05, std::floor((0.8 * lim - fmin) / (minPoints - 1) / 0.05) * 0.05);
+              if (step < fstep) grid = makeGrid(fmin, step, fmax, doubling);
+            }
+          }
+          follow(grid);
+          int reached = 0;
+          for (const auto& p : run.points) reached += p.status != OptimalRatioStatus::NoSteadyState;
+          if (reached >= 2 && reached < minPoints && reached < int(grid.size())) {
+            // The branch ends early (high speed): redo it with minPoints angles up
+            // to the last angle reached, continuing with that step to the end.
+            for (const auto& p : run.points) {
+              run.extra_solves += p.solves;
+              run.extra_newton += p.newton_iterations;
+            }
+            const double last = run.front_deg[reached - 1];
+            const double step = std::floor((last - fmin) / (minPoints - 1) * 1e3) / 1e3;
+            follow(makeGrid(fmin, step, fmax, 0));
+          }
           for (const auto& p : run.points)
             run.yaw_rate_rad_s.push_back(p.status == OptimalRatioStatus::NoSteadyState
                                              ? NAN
@@ -194,12 +253,14 @@ int main(int argc, char** argv) {
       std::vector<double> fd, kr;
       int infeasible = 0;
       double largest = 0;
+      solves += run.extra_solves;
+      newton += run.extra_newton;
       for (std::size_t k = 0; k < run.points.size(); ++k) {
         const OptimalRatioPoint& p = run.points[k];
         solves += p.solves;
         newton += p.newton_iterations;
         krIterations += p.kr_iterations;
-        const double deg = frontsDeg[k];
+        const double deg = run.front_deg[k];
         f << U << ',' << deg << ',' << toString(p.status) << ',';
         if (p.status == OptimalRatioStatus::NoSteadyState) {
           f << ',' << linKr << ",,,,,,," << p.solves << ',' << p.newton_iterations << '\n';
@@ -233,6 +294,7 @@ int main(int argc, char** argv) {
       perSpeed.push_back({{"speed_m_s", U},
                           {"largest_front_deg", largest},
                           {"linear_kr", linKr},
+                          {"passes", run.passes},
                           {"wall_time_s", run.wall_time_s}});
       std::printf("  %6g %8.4f %10.3e %12.3e %9d %6d %11.2f %9.4f %7.2f\n", U, fit.c1, fit.c2_per_deg2,
                   fit.rms_residual, fit.points, infeasible, largest, linKr, run.wall_time_s);
