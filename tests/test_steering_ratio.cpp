@@ -79,11 +79,15 @@ TEST(SteeringRatio, FitRecoversAQuadraticAndTheTableRoundTrips) {
   EXPECT_EQ(f.points, int(d.size()));
   RatioFit g = f;
   g.speed_m_s = 6.0;
-  const Json t = makeRatioTable({f, g});
+  const std::string text = formatRatioTable({f, g});
+  EXPECT_EQ(text.substr(0, 43), "{\n  \"delta_f_unit\": \"deg\",\n  \"fit\": [\n    {");
+  EXPECT_LT(text.find("\"speed_m_s\""), text.find("\"c1\""));  // the documented key order
+  EXPECT_LT(text.find("\"rms_residual\""), text.find("\"points\""));
+  const Json t = Json::parse(text);
   EXPECT_EQ(t["delta_f_unit"], "deg");
   EXPECT_EQ(t["fit"][0]["speed_m_s"], 6.0);  // ascending
   const std::string path = ::testing::TempDir() + "kr_table_test.json";
-  std::ofstream(path) << "// comment line\n" << t.dump(2);
+  std::ofstream(path) << "// comment line\n" << text;
   const auto back = readRatioTable(path);
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back[1].c2_per_deg2, f.c2_per_deg2);
@@ -98,7 +102,7 @@ TEST(SteeringRatio, ErrorsNameTheFieldAndValue) {
   EXPECT_EQ(errorOf([] { fitRatio(12.0, {1.0, -1.0}, {0.1, 0.2}); }),
             "ratio fit at 12 m/s needs at least 2 distinct front angles, got 1");
   EXPECT_EQ(errorOf([] { fitRatio(12.0, {1.0, 2.0}, {0.1}); }), "ratio fit at 12 m/s: 2 front angles but 1 ratios");
-  EXPECT_EQ(errorOf([] { makeRatioTable({RatioFit{12.0}, RatioFit{12.0}}); }),
+  EXPECT_EQ(errorOf([] { formatRatioTable({RatioFit{12.0}, RatioFit{12.0}}); }),
             "ratio table: speed_m_s 12 appears twice");
   const std::string path = ::testing::TempDir() + "kr_table_bad.json";
   std::ofstream(path) << R"({"delta_f_unit": "rad", "fit": []})";

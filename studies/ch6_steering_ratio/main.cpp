@@ -305,8 +305,11 @@ int main(int argc, char** argv) {
       fc << "speed_m_s,c1,c2_per_deg2,rms_residual,points\n";
       for (const auto& x : fits) fc << x.speed_m_s << ',' << x.c1 << ',' << x.c2_per_deg2 << ',' << x.rms_residual << ',' << x.points << '\n';
     }
-    const Json table = makeRatioTable(fits);
-    study::writeJson(out + "/kr_table.json", table);
+    const std::string table = formatRatioTable(fits);
+    {
+      std::ofstream tf(out + "/kr_table.json");
+      if (!(tf << table)) throw Error("cannot write '" + out + "/kr_table.json'");
+    }
     if (vm.count("table-copy")) {
       const std::string path = vm["table-copy"].as<std::string>();
       std::ofstream tc(path);
@@ -314,7 +317,7 @@ int main(int argc, char** argv) {
       tc << "// Kr(delta_f) = c1 + c2_per_deg2 delta_f^2 (8.1), delta_f in deg, App. A 4WS vehicle. Regenerate with\n"
             "//   ./build/bin/ch6_steering_ratio --table-copy vehicles/data/kr_table.json\n"
             "// (the same table, without these lines, is results/ch6_steering_ratio/kr_table.json).\n"
-         << table.dump(2) << '\n';
+         << table;
     }
     const double perSolve = solves ? double(newton) / solves : 0;
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -120,20 +120,20 @@ RatioFit fitRatio(double speed_m_s, const std::vector<double>& front_deg, const 
   return f;
 }
 
-Json makeRatioTable(std::vector<RatioFit> fits) {
+std::string formatRatioTable(std::vector<RatioFit> fits) {
   if (fits.empty()) throw Error("ratio table: no fits");
   std::sort(fits.begin(), fits.end(), [](const RatioFit& x, const RatioFit& y) { return x.speed_m_s < y.speed_m_s; });
-  Json rows = Json::array();
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
   for (std::size_t i = 0; i < fits.size(); ++i) {
     if (i > 0 && fits[i].speed_m_s == fits[i - 1].speed_m_s)
       throw Error("ratio table: speed_m_s " + formatValue(fits[i].speed_m_s) + " appears twice");
-    rows.push_back({{"speed_m_s", fits[i].speed_m_s},
+    rows.push_back(nlohmann::ordered_json{{"speed_m_s", fits[i].speed_m_s},
                     {"c1", fits[i].c1},
                     {"c2_per_deg2", fits[i].c2_per_deg2},
                     {"rms_residual", fits[i].rms_residual},
                     {"points", fits[i].points}});
   }
-  return {{"delta_f_unit", "deg"}, {"fit", rows}};
+  return nlohmann::ordered_json{{"delta_f_unit", "deg"}, {"fit", rows}}.dump(2) + "\n";
 }
 
 std::vector<RatioFit> readRatioTable(const std::string& path) {

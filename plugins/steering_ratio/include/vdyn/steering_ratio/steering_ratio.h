@@ -152,10 +152,10 @@ struct RatioFit {
 /// there are at least two points with distinct |front_deg| and the sizes match.
 RatioFit fitRatio(double speed_m_s, const std::vector<double>& front_deg, const std::vector<double>& kr);
 
-/// The table as JSON: {"delta_f_unit": "deg", "fit": [{"speed_m_s", "c1",
-/// "c2_per_deg2", "rms_residual", "points"}, ...]} with speeds ascending.
-/// Throws Error on an empty table or a repeated speed.
-Json makeRatioTable(std::vector<RatioFit> fits);
+/// The table as JSON text, keys in this order: {"delta_f_unit": "deg", "fit":
+/// [{"speed_m_s", "c1", "c2_per_deg2", "rms_residual", "points"}, ...]}, speeds
+/// ascending, two-space indent. Throws Error on an empty table or a repeated speed.
+std::string formatRatioTable(std::vector<RatioFit> fits);
 /// Reads that table (a file name or path; // comments allowed); throws Error
 /// naming the file and key on a malformed table.
 std::vector<RatioFit> readRatioTable(const std::string& path);
