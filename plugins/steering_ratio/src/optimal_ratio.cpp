@@ -26,6 +26,9 @@ void validate(const OptimalRatioOptions& o) {
   if (o.max_bisections < 0)
     throw Error("optimal ratio max_bisections must be non-negative, got " + std::to_string(o.max_bisections));
   requirePositive(o.kr_perturbation, "optimal ratio kr_perturbation");
+  requireNonNegative(o.stability_skip_margin_per_s, "optimal ratio stability_skip_margin_per_s");
+  if (o.stability_skip_max < 0)
+    throw Error("optimal ratio stability_skip_max must be non-negative, got " + std::to_string(o.stability_skip_max));
   requirePositive(o.max_kr_step, "optimal ratio max_kr_step");
   requireFinite(o.kr_min, "optimal ratio kr_min");
   requireFinite(o.kr_max, "optimal ratio kr_max");
@@ -47,15 +50,26 @@ class PointSolver {
       : solver_(solver), set_(set), slip_(slip), pt_(pt) {}
 
   /// Steady state at (front, kr) from `from`; the unknowns are extrapolated
-  /// linearly through `a`, `b` (converged neighbours, parameter t) when given.
-  std::optional<Trial> solve(double front, double kr, const SteadyStateResult& from, const Trial* a = nullptr,
-                             const Trial* b = nullptr, double ta = 0, double tb = 0, double t = 0) {
+  /// (Lagrange, linear or quadratic) through `nodes` (converged neighbours at
+  /// parameter values t_i) to parameter t when two or three are given.
+  std::optional<Trial> solve(double front, double kr, const SteadyStateResult& from,
+                             const std::vector<std::pair<double, const Trial*>>& nodes = {}, double t = 0) {
     SteadyStateResult guess = from;
     set_(guess.euler_state, front, kr * front);
-    if (a && b && ta != tb) {
-      const Eigen::VectorXd xa = solver_.getUnknowns(a->r.euler_state, a->r.multipliers);
-      const Eigen::VectorXd xb = solver_.getUnknowns(b->r.euler_state, b->r.multipliers);
-      solver_.setGuess(xb + (t - tb) / (tb - ta) * (xb - xa), guess);
+    bool distinct = nodes.size() >= 2;
+    for (std::size_t i = 0; i < nodes.size(); ++i)
+      for (std::size_t j = i + 1; j < nodes.size(); ++j) distinct = distinct && nodes[i].first != nodes[j].first;
+    if (distinct) {
+      Eigen::VectorXd xp;
+      for (std::size_t i = 0; i < nodes.size(); ++i) {
+        double w = 1;
+        for (std::size_t j = 0; j < nodes.size(); ++j)
+          if (j != i) w *= (t - nodes[j].first) / (nodes[i].first - nodes[j].first);
+        const Eigen::VectorXd xi = solver_.getUnknowns(nodes[i].second->r.euler_state, nodes[i].second->r.multipliers);
+        if (i == 0) xp = w * xi;
+        else xp += w * xi;
+      }
+      solver_.setGuess(xp, guess);
     }
     ++pt_.solves;
     try {
@@ -88,7 +102,7 @@ void finish(OptimalRatioPoint& pt, const Trial& t, OptimalRatioStatus status) {
 
 /// (6.13)-(6.15) from a first converged trial at the point's front angle.
 void optimise(SteadyStateSolver& solver, PointSolver& ps, Trial first, double slope, const OptimalRatioOptions& o,
-              OptimalRatioPoint& pt) {
+              OptimalRatioPoint& pt, bool skipZeroVerdict = false) {
   const double front = first.front;
   std::vector<Trial> trials = {first};  // every converged trial at this angle
   Trial cur = first;
@@ -130,7 +144,8 @@ void optimise(SteadyStateSolver& solver, PointSolver& ps, Trial first, double sl
       why = "the zero lies beyond Kr in [" + formatValue(o.kr_min) + ", " + formatValue(o.kr_max) + "]";
       break;
     }
-    std::optional<Trial> n = ps.solve(front, target, cur.r, prev ? &*prev : nullptr, &cur, prev ? prev->kr : 0, cur.kr, target);
+    std::optional<Trial> n = prev ? ps.solve(front, target, cur.r, {{prev->kr, &*prev}, {cur.kr, &cur}}, target)
+                                      : ps.solve(front, target, cur.r);
     if (!n) {
       // Continuation in Kr with step halving toward the target: the furthest
       // steady state reachable. If it is less than half way, the branch ends
@@ -170,7 +185,7 @@ void optimise(SteadyStateSolver& solver, PointSolver& ps, Trial first, double sl
   // The candidate: the zero, or the trial of least |beta|.
   std::sort(trials.begin(), trials.end(),
             [](const Trial& x, const Trial& y) { return std::abs(x.beta) < std::abs(y.beta); });
-  if (!o.check_stability) {
+  if (!o.check_stability || (zero && skipZeroVerdict)) {
     pt.stable = true;
     if (zero) {
       finish(pt, cur, OptimalRatioStatus::ZeroSideSlip);
@@ -185,6 +200,7 @@ void optimise(SteadyStateSolver& solver, PointSolver& ps, Trial first, double sl
   // is stable; between it and a better unstable one, bisect in Kr for the
   // stability boundary (the least |beta| among stable states).
   const Trial* unstableBest = nullptr;
+  pt.stability_checked = true;
   for (const Trial& t : trials) {
     const StabilityResult st = solver.calcStability(t.r);
     if (!st.stable) {
@@ -269,6 +285,8 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
   }
   double slope = 0;  // d beta / d Kr of the last point, rad
   bool ended = false;
+  double lastMargin = 0;  // real part of the least-damped eigenvalue at the last checked point, 1/s
+  int skipped = 0;        // verdicts skipped since
   for (double f : front_rad) {
     OptimalRatioPoint pt;
     pt.front_rad = f;
@@ -280,33 +298,67 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
     PointSolver ps(solver, setSteering, sideSlip, pt);
     const Trial& last = branch.back();
     const Trial* before = branch.size() >= 2 ? &branch[branch.size() - 2] : nullptr;
-    // Predicted Kr: linear through the last two points (the start's Kr counts
-    // only as the first guess).
+    // Predicted Kr: Kr(delta_f) is nearly even (8.1), so through one point
+    // Kr stays, through two Kr = c1 + c2 delta_f^2, through three or more the
+    // quadratic through the last three (the start's Kr is only a guess and does
+    // not count). The state: quadratic through the last three branch points.
+    const std::size_t nk = branch.size() - 1;  // points with an optimal Kr
     double kr = last.kr;
-    if (branch.size() >= 3) kr = last.kr + (f - last.front) * (last.kr - before->kr) / (last.front - before->front);
-    kr = std::clamp(kr, options.kr_min, options.kr_max);
-    // Reach (f, kr) from the last point, halving the step on failure.
-    std::optional<Trial> first = ps.solve(f, kr, last.r, before, &last, before ? before->front : 0, last.front, f);
-    Trial from = last;
-    double ft = f, kt = kr;
-    for (int k = 0; !first && k < options.max_bisections; ++k) {
-      ft = 0.5 * (from.front + ft);
-      kt = 0.5 * (from.kr + kt);
-      auto mid = ps.solve(ft, kt, from.r);
-      if (!mid) continue;
-      from = *mid;
-      ft = f;
-      kt = kr;
-      first = ps.solve(f, kr, from.r);
+    if (nk == 2) {
+      const double d1 = before->front * before->front, d2 = last.front * last.front;
+      kr = last.kr + (f * f - d2) * (last.kr - before->kr) / (d2 - d1);
+    } else if (nk >= 3) {
+      kr = 0;
+      for (std::size_t i = branch.size() - 3; i < branch.size(); ++i) {
+        double w = 1;
+        for (std::size_t j = branch.size() - 3; j < branch.size(); ++j)
+          if (j != i) w *= (f - branch[j].front) / (branch[i].front - branch[j].front);
+        kr += w * branch[i].kr;
+      }
     }
+    kr = std::clamp(kr, options.kr_min, options.kr_max);
+    std::vector<std::pair<double, const Trial*>> nodes;
+    for (std::size_t i = branch.size() - std::min<std::size_t>(3, branch.size()); i < branch.size(); ++i)
+      nodes.emplace_back(branch[i].front, &branch[i]);
+    // Reach (f, kr) from the last point, halving the step on failure; near
+    // the branch's end the extrapolated Kr may have no steady state where the
+    // last point's Kr still has one: that is tried next.
+    auto reach = [&](double krTry, bool predict) {
+      std::optional<Trial> got =
+          predict ? ps.solve(f, krTry, last.r, nodes, f) : ps.solve(f, krTry, last.r);
+      Trial from = last;
+      double ft = f, kt = krTry;
+      for (int k = 0; !got && k < options.max_bisections; ++k) {
+        ft = 0.5 * (from.front + ft);
+        kt = 0.5 * (from.kr + kt);
+        auto mid = ps.solve(ft, kt, from.r);
+        if (!mid) continue;
+        from = *mid;
+        ft = f;
+        kt = krTry;
+        got = ps.solve(f, krTry, from.r);
+      }
+      return got;
+    };
+    std::optional<Trial> first = reach(kr, true);
+    if (!first && kr != last.kr) first = reach(last.kr, false);
     if (!first) {
-      pt.failure = "no steady state reached at front " + formatValue(f) + " rad, Kr " + formatValue(kr) + ": " + pt.failure;
+      pt.failure = "no steady state reached at front " + formatValue(f) + " rad, Kr " + formatValue(kr) + " or " +
+                   formatValue(last.kr) + ": " + pt.failure;
       ended = stop_at_first_failure;
       out.push_back(std::move(pt));
       continue;
     }
     const double slopeGuess = last.front > 0 ? slope * f / last.front : 0;  // beta scales with delta_f
-    optimise(solver, ps, *first, slopeGuess, options, pt);
+    const bool skip = options.stability_skip_margin_per_s > 0 && skipped < options.stability_skip_max &&
+                      lastMargin < -options.stability_skip_margin_per_s;
+    optimise(solver, ps, *first, slopeGuess, options, pt, skip);
+    if (pt.stability_checked) {
+      lastMargin = pt.least_damped_real_per_s;
+      skipped = 0;
+    } else {
+      ++skipped;
+    }
     if (pt.status == OptimalRatioStatus::NoSteadyState) {
       ended = stop_at_first_failure;
     } else {

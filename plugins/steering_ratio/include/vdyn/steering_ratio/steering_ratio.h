@@ -67,7 +67,7 @@ double calcLinearZeroRatioSpeed(const LinearBicycleParams& p);
 struct OptimalRatioOptions {
   /// Converged when |beta| is below this, rad (the steady-state solver's force
   /// tolerance, 1e-6 N, bounds beta's noise to ~1e-11 rad).
-  double side_slip_tolerance_rad = 1e-10;
+  double side_slip_tolerance_rad = 1e-9;
   int max_iterations = 25;              ///< secant-Newton iterations on Kr per point
   /// Perturbation of Kr for the first slope (6.13) when no slope is known yet.
   double kr_perturbation = 1e-3;
@@ -81,6 +81,14 @@ struct OptimalRatioOptions {
   /// state; unstable final states are searched for the least |beta| among
   /// stable ones. Off: every converged steady state counts as admissible.
   bool check_stability = true;
+  /// In followOptimalRatio: the verdict (a linearisation, about as costly as
+  /// the point's solves) may be skipped at a zero-side-slip point when the last
+  /// checked point of the branch had its least-damped eigenvalue's real part
+  /// below -stability_skip_margin_per_s and at most stability_skip_max points
+  /// were skipped since (the eigenvalues move continuously along the branch;
+  /// 0 = check every point). Skipped points report stability_checked = false.
+  double stability_skip_margin_per_s = 0;  ///< 1/s
+  int stability_skip_max = 0;
 };
 
 /// How a point ended.
@@ -98,6 +106,7 @@ struct OptimalRatioPoint {
   double side_slip_rad = 0;       ///< beta at kr
   double dbeta_dkr_rad = 0;       ///< last secant slope d beta / d Kr, rad
   bool stable = false;            ///< verdict of the final state (true if not checked)
+  bool stability_checked = false; ///< the verdict was computed (not skipped or switched off)
   double least_damped_real_per_s = 0;  ///< real part of the least-damped eigenvalue (if checked)
   int kr_iterations = 0;          ///< secant-Newton iterations on Kr
   int solves = 0;                 ///< steady-state solves for this point (including failed ones)
