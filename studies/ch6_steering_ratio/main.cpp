@@ -15,6 +15,7 @@
 #include <atomic>
 #include <chrono>
 #include <cmath>
+#include <ctime>
 #include <cstdio>
 #include <fstream>
 #include <mutex>
@@ -67,6 +68,13 @@ std::vector<double> makeGrid(double min, double step, double max, double doublin
     d += step;
   }
   return g;
+}
+
+/// A message as one CSV field (no commas, quotes or line breaks).
+std::string csvText(std::string t) {
+  for (char& c : t)
+    if (c == ',' || c == '"' || c == '\n') c = ';';
+  return t;
 }
 
 struct SpeedRun {
@@ -149,6 +157,9 @@ int main(int argc, char** argv) {
     // --- Figure 6.4: nonlinear map, one thread per speed -------------------------
     const FourWsParams params = FourWsParams::fromFile(vm["data"].as<std::string>());
     SteadyStateOptions sso;
+    // Converging solves take <= ~15 iterations here; a failing one (beyond the
+    // branch's end) otherwise spends 60 iterations with fresh Jacobians.
+    sso.max_iterations = 30;
     sso.fresh_jacobian_each_solve = vm.count("fresh-jacobian") > 0;
     OptimalRatioOptions oro;
     oro.check_stability = vm.count("no-stability") == 0;
@@ -221,7 +232,9 @@ int main(int argc, char** argv) {
               run.extra_solves += p.solves;
               run.extra_newton += p.newton_iterations;
             }
-            const double last = run.front_deg[reached - 1];
+            double last = 0;
+            for (const auto& p : run.points)
+              if (p.status != OptimalRatioStatus::NoSteadyState) last = p.front_rad / kDeg;
             const double step = std::floor((last - fmin) / (minPoints - 1) * 1e3) / 1e3;
             follow(makeGrid(fmin, step, fmax, 0));
           }
@@ -236,12 +249,14 @@ int main(int argc, char** argv) {
       }
     };
     const auto tm = std::chrono::steady_clock::now();
+    const std::clock_t cm = std::clock();  // process CPU time, all threads
     {
       std::vector<std::thread> pool;
       for (int k = 0; k < threads; ++k) pool.emplace_back(worker);
       for (auto& t : pool) t.join();
     }
     const double mapWall = std::chrono::duration<double>(std::chrono::steady_clock::now() - tm).count();
+    const double mapCpu = double(std::clock() - cm) / CLOCKS_PER_SEC;
     for (const auto& r : runs)
       if (!r.error.empty()) throw Error(r.error);
 
@@ -249,7 +264,7 @@ int main(int argc, char** argv) {
     const std::string mapCsv = out + "/kr_map.csv";
     std::ofstream f(mapCsv);
     f << "speed_m_s,front_deg,status,kr,linear_kr,side_slip_rad,yaw_rate_rad_s,lateral_acceleration_m_s2,stable,"
-         "stability_checked,least_damped_real_per_s,kr_iterations,solves,newton_iterations\n";
+         "stability_checked,least_damped_real_per_s,kr_iterations,solves,newton_iterations,note\n";
     std::vector<RatioFit> fits;
     Json fitJson = Json::array(), perSpeed = Json::array();
     long solves = 0, newton = 0, krIterations = 0, mapPoints = 0;
@@ -269,10 +284,10 @@ int main(int argc, char** argv) {
         solves += p.solves;
         newton += p.newton_iterations;
         krIterations += p.kr_iterations;
-        const double deg = run.front_deg[k];
+        const double deg = p.front_rad / kDeg;
         f << U << ',' << deg << ',' << toString(p.status) << ',';
         if (p.status == OptimalRatioStatus::NoSteadyState) {
-          f << ',' << linKr << ",,,,,,,," << p.solves << ',' << p.newton_iterations << '\n';
+          f << ',' << linKr << ",,,,,,,," << p.solves << ',' << p.newton_iterations << ',' << csvText(p.failure) << '\n';
           continue;
         }
         ++mapPoints;
@@ -286,7 +301,7 @@ int main(int argc, char** argv) {
         const double r = run.yaw_rate_rad_s[k];
         f << p.kr << ',' << linKr << ',' << p.side_slip_rad << ',' << r << ',' << U * r << ',' << (p.stable ? 1 : 0)
           << ',' << (p.stability_checked ? 1 : 0) << ',' << (p.stability_checked ? formatValue(p.least_damped_real_per_s) : "") << ',' << p.kr_iterations << ',' << p.solves << ','
-          << p.newton_iterations << '\n';
+          << p.newton_iterations << ',' << csvText(p.failure) << '\n';
       }
       RatioFit fit;
       fit.speed_m_s = U;
@@ -334,6 +349,7 @@ int main(int argc, char** argv) {
                                              {"linear_zero_crossing_m_s", zeroSpeed},
                                              {"fit", fitJson},
                                              {"map_wall_time_s", mapWall},
+                                             {"map_cpu_time_s", mapCpu},
                                              {"map_points", mapPoints},
                                              {"steady_state_solves", solves},
                                              {"newton_iterations", newton},
@@ -343,9 +359,9 @@ int main(int argc, char** argv) {
                                              {"fresh_jacobian_each_solve", sso.fresh_jacobian_each_solve},
                                              {"speeds", perSpeed},
                                              {"wall_time_s", wall}});
-    std::printf("  map: %ld points in %.2f s wall (%d threads): %ld steady-state solves, %.2f Newton iterations per "
-                "solve, %.2f Kr iterations per point\n",
-                mapPoints, mapWall, threads, solves, perSolve, mapPoints ? double(krIterations) / mapPoints : 0.0);
+    std::printf("  map: %ld points in %.2f s wall (%d threads; %.2f s CPU): %ld steady-state solves, %.2f Newton "
+                "iterations per solve, %.2f Kr iterations per point\n",
+                mapPoints, mapWall, threads, mapCpu, solves, perSolve, mapPoints ? double(krIterations) / mapPoints : 0.0);
 
     if (!vm.count("no-plots")) {
       std::vector<study::Series> lin62 = {{out + "/linear_kr.csv", "speed_m_s", "kr", "linear bicycle (6.9)"}};

@@ -23,6 +23,8 @@ void validate(const OptimalRatioOptions& o) {
   requirePositive(o.side_slip_tolerance_rad, "optimal ratio side_slip_tolerance_rad");
   if (o.max_iterations < 1)
     throw Error("optimal ratio max_iterations must be at least 1, got " + std::to_string(o.max_iterations));
+  if (o.end_bisections < 0)
+    throw Error("optimal ratio end_bisections must be non-negative, got " + std::to_string(o.end_bisections));
   if (o.max_bisections < 0)
     throw Error("optimal ratio max_bisections must be non-negative, got " + std::to_string(o.max_bisections));
   requirePositive(o.kr_perturbation, "optimal ratio kr_perturbation");
@@ -287,14 +289,10 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
   bool ended = false;
   double lastMargin = 0;  // real part of the least-damped eigenvalue at the last checked point, 1/s
   int skipped = 0;        // verdicts skipped since
-  for (double f : front_rad) {
+  // One point at front angle f from the branch's last point; extends the branch.
+  auto attempt = [&](double f) {
     OptimalRatioPoint pt;
     pt.front_rad = f;
-    if (ended) {
-      pt.failure = "the branch ended at a smaller front angle";
-      out.push_back(std::move(pt));
-      continue;
-    }
     PointSolver ps(solver, setSteering, sideSlip, pt);
     const Trial& last = branch.back();
     const Trial* before = branch.size() >= 2 ? &branch[branch.size() - 2] : nullptr;
@@ -323,9 +321,8 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
     // Reach (f, kr) from the last point, halving the step on failure; near
     // the branch's end the extrapolated Kr may have no steady state where the
     // last point's Kr still has one: that is tried next.
-    auto reach = [&](double krTry, bool predict) {
-      std::optional<Trial> got =
-          predict ? ps.solve(f, krTry, last.r, nodes, f) : ps.solve(f, krTry, last.r);
+    auto reach = [&](double krTry) {
+      std::optional<Trial> got = ps.solve(f, krTry, last.r);
       Trial from = last;
       double ft = f, kt = krTry;
       for (int k = 0; !got && k < options.max_bisections; ++k) {
@@ -340,14 +337,15 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
       }
       return got;
     };
-    std::optional<Trial> first = reach(kr, true);
-    if (!first && kr != last.kr) first = reach(last.kr, false);
+    // First the extrapolated state, then (near a fold it can overshoot) the
+    // last point's state with step halving, then the last point's Kr.
+    std::optional<Trial> first = ps.solve(f, kr, last.r, nodes, f);
+    if (!first) first = reach(kr);
+    if (!first && kr != last.kr) first = reach(last.kr);
     if (!first) {
       pt.failure = "no steady state reached at front " + formatValue(f) + " rad, Kr " + formatValue(kr) + " or " +
                    formatValue(last.kr) + ": " + pt.failure;
-      ended = stop_at_first_failure;
-      out.push_back(std::move(pt));
-      continue;
+      return pt;
     }
     const double slopeGuess = last.front > 0 ? slope * f / last.front : 0;  // beta scales with delta_f
     const bool skip = options.stability_skip_margin_per_s > 0 && skipped < options.stability_skip_max &&
@@ -359,9 +357,7 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
     } else {
       ++skipped;
     }
-    if (pt.status == OptimalRatioStatus::NoSteadyState) {
-      ended = stop_at_first_failure;
-    } else {
+    if (pt.status != OptimalRatioStatus::NoSteadyState) {
       slope = pt.dbeta_dkr_rad;
       Trial t;
       t.front = f;
@@ -369,6 +365,35 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
       t.beta = pt.side_slip_rad;
       t.r = pt.result;
       branch.push_back(std::move(t));
+    }
+    return pt;
+  };
+  for (double f : front_rad) {
+    if (ended) {
+      OptimalRatioPoint pt;
+      pt.front_rad = f;
+      pt.failure = "the branch ended at a smaller front angle";
+      out.push_back(std::move(pt));
+      continue;
+    }
+    OptimalRatioPoint pt = attempt(f);
+    if (pt.status == OptimalRatioStatus::NoSteadyState && stop_at_first_failure) {
+      // Locate the branch's end: bisect between the last point and f; the
+      // angles that have a steady state are inserted as points.
+      double lo = branch.back().front, hi = f;
+      for (int k = 0; k < options.end_bisections; ++k) {
+        const double fm = 0.5 * (lo + hi);
+        OptimalRatioPoint pm = attempt(fm);
+        if (pm.status != OptimalRatioStatus::NoSteadyState) {
+          lo = fm;
+          out.push_back(std::move(pm));
+        } else {
+          hi = fm;
+          pt.solves += pm.solves;  // the failed tries count toward the failing point
+          pt.newton_iterations += pm.newton_iterations;
+        }
+      }
+      ended = true;
     }
     out.push_back(std::move(pt));
   }

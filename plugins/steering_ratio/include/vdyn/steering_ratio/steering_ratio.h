@@ -77,6 +77,10 @@ struct OptimalRatioOptions {
   /// halved up to this many times toward the last good Kr; where moving to the
   /// next front angle fails, the angle step is halved as often.
   int max_bisections = 5;
+  /// In followOptimalRatio, where the branch ends between two front angles,
+  /// the end is located by this many bisections of that interval; the angles
+  /// with a steady state are inserted as extra points.
+  int end_bisections = 2;
   /// Check stability (SteadyStateSolver::calcStability) of each point's final
   /// state; unstable final states are searched for the least |beta| among
   /// stable ones. Off: every converged steady state counts as admissible.
@@ -137,8 +141,11 @@ OptimalRatioPoint solveOptimalRatio(SteadyStateSolver& solver, const SteadyState
 /// each point starts from its neighbour's steady state and Kr (extrapolated
 /// linearly through the last two), starting at `start` (a steady state at
 /// front angle 0, e.g. straight running) with `kr_start` (e.g. the linear
-/// law). With stop_at_first_failure, points after the first NoSteadyState are
-/// reported as NoSteadyState without solving (the branch has ended).
+/// law). With stop_at_first_failure, the branch's end is located by bisection
+/// (OptimalRatioOptions::end_bisections; the points found there are inserted,
+/// so the result can hold more points than `front_rad`, in ascending order)
+/// and points after the first NoSteadyState are reported as NoSteadyState
+/// without solving.
 std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, const SteadyStateResult& start,
                                                   const std::vector<double>& front_rad, double kr_start,
                                                   const SetSteering& setSteering, const SideSlipOf& sideSlip,
