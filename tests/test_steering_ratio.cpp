@@ -221,3 +221,53 @@ TEST(SteeringRatio, ContinuationInFrontAngleKeepsSideSlipZero) {
   EXPECT_EQ(errorOf([&] { solveOptimalRatio(*v.solver, v.straight, 0.01, 0.0, v.steer(), chassisSlip, bad); }),
             "optimal ratio max_kr_step must be positive, got 0");
 }
+
+TEST(SteeringRatio, GimTireBranchEndsWithAdmissiblePointsOnly) {
+  // The App. A vehicle as built (Gim tires) at 25 m/s: steady states exist only
+  // up to about 2 deg of front angle. Every point before the end has zero side
+  // slip (or is flagged), is stable where checked, and the end is located
+  // between two front angles by bisection (inserted points ascend).
+  const double U = 25.0;
+  FourWsParams p = FourWsParams::fromFile("appendix_a.json");
+  FourWsVehicle car(p);
+  auto front = std::make_shared<AdjustableHoldCommand>(0.0), rear = std::make_shared<AdjustableHoldCommand>(0.0);
+  car.addAxleSteering("front_steer", true, front);
+  car.addAxleSteering("rear_steer", false, rear);
+  const auto& hold = static_cast<const SpeedHoldPlugin&>(
+      car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U)));
+  const Scene& sc = car.getScene();
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
+  SimTK::State s = car.makeInitialState(U);
+  hold.setSpeed(s, U);
+  const SteadyStateResult straight = solver.solve(s);
+  const SetSteering steer = [&](SimTK::State&, double f, double r) {
+    front->setAngle(f);
+    rear->setAngle(r);
+  };
+  const SideSlipOf slip = [&](const SimTK::State& st) { return sc.evalOutput("chassis.side_slip_rad", st); };
+  OptimalRatioOptions o;
+  o.max_bisections = 2;
+  const auto pts = followOptimalRatio(solver, straight, {1.5 * kDeg, 2.0 * kDeg, 2.5 * kDeg, 3.0 * kDeg}, 0.5, steer, slip, o);
+  ASSERT_GE(pts.size(), 4u);
+  int reached = 0;
+  for (std::size_t i = 0; i < pts.size(); ++i) {
+    const auto& q = pts[i];
+    std::printf("front %.4f deg: %s Kr %.5f beta %.3e stable %d\n", q.front_rad / kDeg, toString(q.status), q.kr,
+                q.side_slip_rad, q.stable);
+    if (i > 0) EXPECT_GT(q.front_rad, pts[i - 1].front_rad);
+    if (q.status == OptimalRatioStatus::NoSteadyState) continue;
+    ++reached;
+    EXPECT_TRUE(q.stable);
+    if (q.status == OptimalRatioStatus::ZeroSideSlip) EXPECT_LT(std::abs(slip(q.result.state)), 1e-8);
+    else EXPECT_FALSE(q.failure.empty());
+  }
+  EXPECT_GE(reached, 2);
+  // The requested 1.5 and 2 deg are reached (by halving the first step from 0).
+  for (const auto& q : pts)
+    if (std::abs(q.front_rad - 1.5 * kDeg) < 1e-12 || std::abs(q.front_rad - 2.0 * kDeg) < 1e-12)
+      EXPECT_EQ(q.status, OptimalRatioStatus::ZeroSideSlip) << q.front_rad / kDeg << ": " << q.failure;
+  EXPECT_EQ(pts.back().status, OptimalRatioStatus::NoSteadyState);  // 3 deg is beyond the branch at 25 m/s
+  // In phase at 25 m/s, and growing with the front angle (tire saturation).
+  EXPECT_GT(pts[0].kr, 0.4);
+  EXPECT_GT(pts[1].kr, pts[0].kr);
+}

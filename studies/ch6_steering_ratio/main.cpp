@@ -112,7 +112,11 @@ int main(int argc, char** argv) {
         "stability-skip-margin-per-s", po::value<double>()->default_value(3.0),
         "skip the stability verdict at a zero-side-slip point while the last checked point's least-damped "
         "eigenvalue has real part below minus this, 1/s (0: check every point)")(
-        "stability-skip-max", po::value<int>()->default_value(2), "at most this many verdicts skipped in a row")(
+        "stability-skip-max", po::value<int>()->default_value(3), "at most this many verdicts skipped in a row")(
+        "force-tolerance-n", po::value<double>()->default_value(1e-6),
+        "steady-state force residual tolerance, N (beta's error ~ this / axle cornering stiffness)")(
+        "bisections", po::value<int>()->default_value(2),
+        "step halvings when a steady state is not reached (front angle, Kr) before giving up")(
         "no-stability", "admit every converged steady state (skip the stability verdict)")(
         "no-plots", "skip the PNG plots");
     const auto vm = study::parse("ch6_steering_ratio", "optimal 4WS steering ratio: linear law, nonlinear map, fit",
@@ -160,9 +164,12 @@ int main(int argc, char** argv) {
     // Converging solves take <= ~15 iterations here; a failing one (beyond the
     // branch's end) otherwise spends 60 iterations with fresh Jacobians.
     sso.max_iterations = 30;
+    sso.force_tolerance = requirePositive(vm["force-tolerance-n"].as<double>(), "--force-tolerance-n");
     sso.fresh_jacobian_each_solve = vm.count("fresh-jacobian") > 0;
     OptimalRatioOptions oro;
     oro.check_stability = vm.count("no-stability") == 0;
+    oro.max_bisections = vm["bisections"].as<int>();
+    if (oro.max_bisections < 0) throw Error("--bisections must be non-negative, got " + std::to_string(oro.max_bisections));
     oro.stability_skip_margin_per_s =
         requireNonNegative(vm["stability-skip-margin-per-s"].as<double>(), "--stability-skip-margin-per-s");
     oro.stability_skip_max = vm["stability-skip-max"].as<int>();

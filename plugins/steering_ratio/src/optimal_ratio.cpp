@@ -377,24 +377,30 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
       continue;
     }
     OptimalRatioPoint pt = attempt(f);
-    if (pt.status == OptimalRatioStatus::NoSteadyState && stop_at_first_failure) {
-      // Locate the branch's end: bisect between the last point and f; the
-      // angles that have a steady state are inserted as points.
-      double lo = branch.back().front, hi = f;
-      for (int k = 0; k < options.end_bisections; ++k) {
-        const double fm = 0.5 * (lo + hi);
-        OptimalRatioPoint pm = attempt(fm);
-        if (pm.status != OptimalRatioStatus::NoSteadyState) {
-          lo = fm;
-          out.push_back(std::move(pm));
-        } else {
-          hi = fm;
-          pt.solves += pm.solves;  // the failed tries count toward the failing point
-          pt.newton_iterations += pm.newton_iterations;
-        }
+    // Step halving: where f is not reached, the midpoint from the last point
+    // is tried; a midpoint with a steady state is inserted as a point and f
+    // retried from it, one without narrows the interval. After end_bisections
+    // halvings without reaching f, the branch has ended (between the last
+    // point and f).
+    double hi = f;
+    for (int k = 0; pt.status == OptimalRatioStatus::NoSteadyState && k < options.end_bisections; ++k) {
+      const double fm = 0.5 * (branch.back().front + hi);
+      OptimalRatioPoint pm = attempt(fm);
+      const int failedSolves = pt.solves, failedIterations = pt.newton_iterations;
+      if (pm.status != OptimalRatioStatus::NoSteadyState) {
+        out.push_back(std::move(pm));
+        pt = attempt(f);
+        hi = f;
+      } else {
+        hi = fm;
+        pt.solves += pm.solves;
+        pt.newton_iterations += pm.newton_iterations;
+        continue;
       }
-      ended = true;
+      pt.solves += failedSolves;  // the failed tries count toward the point
+      pt.newton_iterations += failedIterations;
     }
+    if (pt.status == OptimalRatioStatus::NoSteadyState) ended = stop_at_first_failure;
     out.push_back(std::move(pt));
   }
   return out;
