@@ -115,8 +115,11 @@ int main(int argc, char** argv) {
         "stability-skip-max", po::value<int>()->default_value(3), "at most this many verdicts skipped in a row")(
         "force-tolerance-n", po::value<double>()->default_value(1e-6),
         "steady-state force residual tolerance, N (beta's error ~ this / axle cornering stiffness)")(
-        "bisections", po::value<int>()->default_value(2),
+        "bisections", po::value<int>()->default_value(1),
         "step halvings when a steady state is not reached (front angle, Kr) before giving up")(
+        "end-bisections", po::value<int>()->default_value(2),
+        "halvings of a front-angle step that is not reached before the branch is declared ended")(
+        "max-newton-iterations", po::value<int>()->default_value(30), "Newton iterations per steady-state solve at most")(
         "no-stability", "admit every converged steady state (skip the stability verdict)")(
         "no-plots", "skip the PNG plots");
     const auto vm = study::parse("ch6_steering_ratio", "optimal 4WS steering ratio: linear law, nonlinear map, fit",
@@ -161,14 +164,19 @@ int main(int argc, char** argv) {
     // --- Figure 6.4: nonlinear map, one thread per speed -------------------------
     const FourWsParams params = FourWsParams::fromFile(vm["data"].as<std::string>());
     SteadyStateOptions sso;
-    // Converging solves take <= ~15 iterations here; a failing one (beyond the
-    // branch's end) otherwise spends 60 iterations with fresh Jacobians.
-    sso.max_iterations = 30;
+    // Converging solves here take about 4 iterations; a failing one (beyond the
+    // branch's end) spends all of them, most with a fresh Jacobian: 30, not 60.
+    sso.max_iterations = vm["max-newton-iterations"].as<int>();
+    if (sso.max_iterations < 1)
+      throw Error("--max-newton-iterations must be at least 1, got " + std::to_string(sso.max_iterations));
     sso.force_tolerance = requirePositive(vm["force-tolerance-n"].as<double>(), "--force-tolerance-n");
     sso.fresh_jacobian_each_solve = vm.count("fresh-jacobian") > 0;
     OptimalRatioOptions oro;
     oro.check_stability = vm.count("no-stability") == 0;
     oro.max_bisections = vm["bisections"].as<int>();
+    oro.end_bisections = vm["end-bisections"].as<int>();
+    if (oro.end_bisections < 0)
+      throw Error("--end-bisections must be non-negative, got " + std::to_string(oro.end_bisections));
     if (oro.max_bisections < 0) throw Error("--bisections must be non-negative, got " + std::to_string(oro.max_bisections));
     oro.stability_skip_margin_per_s =
         requireNonNegative(vm["stability-skip-margin-per-s"].as<double>(), "--stability-skip-margin-per-s");
