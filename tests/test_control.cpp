@@ -188,12 +188,12 @@ TEST(PathControl, SteersBackToAStraightPathFromALateralOffset) {
 TEST(RearSteer, LinearBicycleRatio) {
   const LinearBicycleParams p;  // chapter 6: M 1024 kg, a 1.305 m, b 0.965 m, C 1.4e5 N/rad per axle
   const double l = 2.27, U = 20;
-  EXPECT_NEAR(p.calcKr(U), (-0.965 + 1024 * 1.305 * U * U / (1.4e5 * l)) / (1.305 + 1024 * 0.965 * U * U / (1.4e5 * l)),
+  EXPECT_NEAR(calcLinearOptimalRatio(p, U), (-0.965 + 1024 * 1.305 * U * U / (1.4e5 * l)) / (1.305 + 1024 * 0.965 * U * U / (1.4e5 * l)),
               1e-15);
-  EXPECT_NEAR(p.calcKr(0.0), -0.965 / 1.305, 1e-15);  // kinematic contra phase at rest: -b / a
+  EXPECT_NEAR(calcLinearOptimalRatio(p, 0.0), -0.965 / 1.305, 1e-15);  // kinematic contra phase at rest: -b / a
   // Zero where M a U^2 = b C_ar l: 15.15 m/s.
   const double U0 = std::sqrt(0.965 * 1.4e5 * l / (1024 * 1.305));
-  EXPECT_NEAR(p.calcKr(U0), 0.0, 1e-15);
+  EXPECT_NEAR(calcLinearOptimalRatio(p, U0), 0.0, 1e-15);
   EXPECT_NEAR(U0, 15.149, 0.001);
 }
 
@@ -293,7 +293,7 @@ TEST(RearSteer, TrackingErrorDecaysAsTheG1G2ClosedForm) {
   EXPECT_LE(rearTrackingMismatch(std::make_shared<LinearKrStrategy>(LinearBicycleParams{}), kr), 1e-6);
   // Kr at the measured horizontal speed of the chassis (16 m/s held in the
   // chassis frame, so pitch leaves it 1e-5 off).
-  EXPECT_NEAR(kr, LinearBicycleParams{}.calcKr(16.0), 1e-4);
+  EXPECT_NEAR(kr, calcLinearOptimalRatio(LinearBicycleParams{}, 16.0), 1e-4);
   KrTable t;
   t.rows = {{12.0, -0.1, 0.002}, {20.0, 0.3, 0.006}};
   EXPECT_LE(rearTrackingMismatch(std::make_shared<NonlinearKrStrategy>(t), kr), 1e-6);

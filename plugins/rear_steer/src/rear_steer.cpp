@@ -6,32 +6,6 @@ namespace vdyn {
 
 using SimTK::Vec3;
 
-void LinearBicycleParams::validate() const {
-  requirePositive(mass_kg, "linear bicycle mass_kg");
-  requirePositive(front_axle_to_cm_m, "linear bicycle front_axle_to_cm_m");
-  requirePositive(rear_axle_to_cm_m, "linear bicycle rear_axle_to_cm_m");
-  requirePositive(front_cornering_stiffness_N_per_rad, "linear bicycle front_cornering_stiffness_N_per_rad");
-  requirePositive(rear_cornering_stiffness_N_per_rad, "linear bicycle rear_cornering_stiffness_N_per_rad");
-}
-
-LinearBicycleParams LinearBicycleParams::fromParams(const ParamReader& r) {
-  LinearBicycleParams p;
-  p.mass_kg = r.number("mass_kg");
-  p.front_axle_to_cm_m = r.number("front_axle_to_cm_m");
-  p.rear_axle_to_cm_m = r.number("rear_axle_to_cm_m");
-  p.front_cornering_stiffness_N_per_rad = r.number("front_cornering_stiffness_N_per_rad");
-  p.rear_cornering_stiffness_N_per_rad = r.number("rear_cornering_stiffness_N_per_rad");
-  p.validate();
-  return p;
-}
-
-double LinearBicycleParams::calcKr(double U) const {
-  requireFinite(U, "linear bicycle speed_m_s");
-  const double a = front_axle_to_cm_m, b = rear_axle_to_cm_m, l = a + b, M = mass_kg;
-  return (-b + M * a * U * U / (rear_cornering_stiffness_N_per_rad * l)) /
-         (a + M * b * U * U / (front_cornering_stiffness_N_per_rad * l));
-}
-
 // ---------------------------------------------------------------------------
 void KrTable::validate(const std::string& where) const {
   if (rows.empty()) throw Error(where + ": the table has no rows");
@@ -82,7 +56,7 @@ RearSteerTarget RearSteerStrategy::calcTarget(double U, double df, double dfd, d
 LinearKrStrategy::LinearKrStrategy(const LinearBicycleParams& p) : p_(p) { p_.validate(); }
 
 RearSteerTarget LinearKrStrategy::DoCalcTarget(double U, double df, double dfd, double dfdd) const {
-  const double kr = p_.calcKr(U);
+  const double kr = calcLinearOptimalRatio(p_, U);
   return {kr * df, kr * dfd, kr * dfdd, kr};  // (8.2)-(8.4)
 }
 

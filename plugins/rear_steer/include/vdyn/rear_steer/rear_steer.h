@@ -25,25 +25,13 @@
 #include "vdyn/core/registry.h"
 #include "vdyn/core/scene.h"
 #include "vdyn/steering/steering.h"
+#include "vdyn/steering_ratio/steering_ratio.h"
 
 namespace vdyn {
 
 /// The linear bicycle of chapter 6 (6.1)-(6.9), for Kr(U).
-struct LinearBicycleParams {
-  double mass_kg = 1024;                              ///< M (chapter 6)
-  double front_axle_to_cm_m = 1.305;                  ///< a, m
-  double rear_axle_to_cm_m = 0.965;                   ///< b, m
-  double front_cornering_stiffness_N_per_rad = 1.4e5; ///< C_af, both tires of the axle, N/rad
-  double rear_cornering_stiffness_N_per_rad = 1.4e5;  ///< C_ar, N/rad
-
-  void validate() const;
-  /// Keys mass_kg, front_axle_to_cm_m, rear_axle_to_cm_m,
-  /// front_cornering_stiffness_N_per_rad, rear_cornering_stiffness_N_per_rad.
-  static LinearBicycleParams fromParams(const ParamReader& r);
-  /// Zero steady side slip: Kr = (-b + M a U^2 / (C_ar l)) / (a + M b U^2 / (C_af l)),
-  /// l = a + b (DESIGN.md section 5). Negative below about 14 m/s.
-  double calcKr(double speed_m_s) const;
-};
+// LinearBicycleParams and the linear law (6.9), calcLinearOptimalRatio(), come
+// from vdyn/steering_ratio/steering_ratio.h (one definition for both issues).
 
 /// Coefficients of (8.1) against speed (Table 8.1). JSON:
 /// {"delta_f_unit": "deg", "fit": [{"speed_m_s": 6.0, "c1": ..., "c2_per_deg2": ...}, ...]}

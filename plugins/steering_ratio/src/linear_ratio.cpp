@@ -1,0 +1,160 @@
+// Linear bicycle (6.1)-(6.9), fit (8.1) and the coefficient table.
+#include <algorithm>
+#include <cmath>
+#include <set>
+
+#include "vdyn/steering_ratio/steering_ratio.h"
+
+namespace vdyn {
+
+// --- linear bicycle -------------------------------------------------------------
+
+double LinearBicycleParams::understeerGradient() const {
+  const double l = wheelbase_m();
+  return mass_kg / l *
+         (rear_axle_to_com_m / front_cornering_stiffness_N_per_rad - front_axle_to_com_m / rear_cornering_stiffness_N_per_rad);
+}
+
+void LinearBicycleParams::validate() const {
+  requirePositive(mass_kg, "linear bicycle mass_kg");
+  requirePositive(front_axle_to_com_m, "linear bicycle front_axle_to_com_m");
+  requirePositive(rear_axle_to_com_m, "linear bicycle rear_axle_to_com_m");
+  requirePositive(front_cornering_stiffness_N_per_rad, "linear bicycle front_cornering_stiffness_N_per_rad");
+  requirePositive(rear_cornering_stiffness_N_per_rad, "linear bicycle rear_cornering_stiffness_N_per_rad");
+}
+
+LinearBicycleParams LinearBicycleParams::fromParams(const ParamReader& r) {
+  LinearBicycleParams p;
+  p.mass_kg = r.number("mass_kg");
+  p.front_axle_to_com_m = r.number("front_axle_to_com_m");
+  p.rear_axle_to_com_m = r.number("rear_axle_to_com_m");
+  p.front_cornering_stiffness_N_per_rad = r.number("front_cornering_stiffness_N_per_rad");
+  p.rear_cornering_stiffness_N_per_rad = r.number("rear_cornering_stiffness_N_per_rad");
+  try {
+    p.validate();
+  } catch (const Error& e) {
+    throw Error(r.where() + ": " + e.what());
+  }
+  return p;
+}
+
+LinearBicycleParams LinearBicycleParams::fromFile(const std::string& path) {
+  return fromParams(ParamReader::fromFile(path));
+}
+
+namespace {
+void checkInputs(const LinearBicycleParams& p, double U, double front, double kr) {
+  p.validate();
+  requireNonNegative(U, "linear bicycle speed_m_s");  // at rest: the kinematic -b / a
+  requireFinite(front, "front_rad");
+  requireFinite(kr, "kr");
+}
+}  // namespace
+
+// Steady (6.5)-(6.6), beta' = r' = 0. The moment balance gives the axle forces
+// F_f = M U r b / l, F_r = M U r a / l; with (6.1)-(6.2),
+//   F_f = C_af (delta_f - beta - a r / U),  F_r = C_ar (Kr delta_f - beta + b r / U),
+// eliminating beta: delta_f (1 - Kr) = r / U (l + K U^2).
+double calcLinearSteadyYawRate(const LinearBicycleParams& p, double U, double front, double kr) {
+  checkInputs(p, U, front, kr);
+  return U * front * (1 - kr) / (p.wheelbase_m() + p.understeerGradient() * U * U);
+}
+
+// (6.7): beta = delta_f - r / U (a + M b U^2 / (C_af l)).
+double calcLinearSteadySideSlip(const LinearBicycleParams& p, double U, double front, double kr) {
+  const double r = calcLinearSteadyYawRate(p, U, front, kr);
+  const double l = p.wheelbase_m();
+  return front - r / U * (p.front_axle_to_com_m + p.mass_kg * p.rear_axle_to_com_m * U * U /
+                                                       (p.front_cornering_stiffness_N_per_rad * l));
+}
+
+// (6.9).
+double calcLinearOptimalRatio(const LinearBicycleParams& p, double U) {
+  checkInputs(p, U, 0, 0);
+  const double l = p.wheelbase_m(), a = p.front_axle_to_com_m, b = p.rear_axle_to_com_m, M = p.mass_kg;
+  return (-b + M * a * U * U / (p.rear_cornering_stiffness_N_per_rad * l)) /
+         (a + M * b * U * U / (p.front_cornering_stiffness_N_per_rad * l));
+}
+
+double calcLinearZeroRatioSpeed(const LinearBicycleParams& p) {
+  p.validate();
+  return std::sqrt(p.rear_axle_to_com_m * p.rear_cornering_stiffness_N_per_rad * p.wheelbase_m() /
+                   (p.mass_kg * p.front_axle_to_com_m));
+}
+
+// --- fit (8.1) --------------------------------------------------------------------
+
+RatioFit fitRatio(double speed_m_s, const std::vector<double>& front_deg, const std::vector<double>& kr) {
+  requirePositive(speed_m_s, "ratio fit speed_m_s");
+  if (front_deg.size() != kr.size())
+    throw Error("ratio fit at " + formatValue(speed_m_s) + " m/s: " + std::to_string(front_deg.size()) +
+                " front angles but " + std::to_string(kr.size()) + " ratios");
+  std::set<double> distinct;
+  for (std::size_t i = 0; i < kr.size(); ++i) {
+    distinct.insert(std::abs(requireFinite(front_deg[i], "ratio fit front_deg")));
+    requireFinite(kr[i], "ratio fit kr");
+  }
+  if (distinct.size() < 2)
+    throw Error("ratio fit at " + formatValue(speed_m_s) + " m/s needs at least 2 distinct front angles, got " +
+                std::to_string(distinct.size()));
+  // Normal equations of [1, d^2] [c1; c2] = Kr, 2 x 2 (well conditioned for
+  // angles of a few degrees).
+  double n = 0, s2 = 0, s4 = 0, sk = 0, s2k = 0;
+  for (std::size_t i = 0; i < kr.size(); ++i) {
+    const double d2 = front_deg[i] * front_deg[i];
+    n += 1;
+    s2 += d2;
+    s4 += d2 * d2;
+    sk += kr[i];
+    s2k += d2 * kr[i];
+  }
+  const double det = n * s4 - s2 * s2;
+  RatioFit f;
+  f.speed_m_s = speed_m_s;
+  f.c1 = (s4 * sk - s2 * s2k) / det;
+  f.c2_per_deg2 = (n * s2k - s2 * sk) / det;
+  double ss = 0;
+  for (std::size_t i = 0; i < kr.size(); ++i) ss += std::pow(kr[i] - f.evaluate(front_deg[i]), 2);
+  f.rms_residual = std::sqrt(ss / n);
+  f.points = int(kr.size());
+  return f;
+}
+
+std::string formatRatioTable(std::vector<RatioFit> fits) {
+  if (fits.empty()) throw Error("ratio table: no fits");
+  std::sort(fits.begin(), fits.end(), [](const RatioFit& x, const RatioFit& y) { return x.speed_m_s < y.speed_m_s; });
+  nlohmann::ordered_json rows = nlohmann::ordered_json::array();
+  for (std::size_t i = 0; i < fits.size(); ++i) {
+    if (i > 0 && fits[i].speed_m_s == fits[i - 1].speed_m_s)
+      throw Error("ratio table: speed_m_s " + formatValue(fits[i].speed_m_s) + " appears twice");
+    rows.push_back(nlohmann::ordered_json{{"speed_m_s", fits[i].speed_m_s},
+                    {"c1", fits[i].c1},
+                    {"c2_per_deg2", fits[i].c2_per_deg2},
+                    {"rms_residual", fits[i].rms_residual},
+                    {"points", fits[i].points}});
+  }
+  return nlohmann::ordered_json{{"delta_f_unit", "deg"}, {"fit", rows}}.dump(2) + "\n";
+}
+
+std::vector<RatioFit> readRatioTable(const std::string& path) {
+  const ParamReader r = ParamReader::fromFile(path);
+  const std::string unit = r.string("delta_f_unit");
+  if (unit != "deg") throw Error(r.at("delta_f_unit") + ": expected \"deg\", got \"" + unit + "\"");
+  std::vector<RatioFit> fits;
+  for (const ParamReader& row : r.array("fit")) {
+    RatioFit f;
+    f.speed_m_s = row.number("speed_m_s");
+    f.c1 = row.number("c1");
+    f.c2_per_deg2 = row.number("c2_per_deg2");
+    f.rms_residual = row.number("rms_residual");
+    f.points = row.integer("points");
+    if (!fits.empty() && !(f.speed_m_s > fits.back().speed_m_s))
+      throw Error(row.at("speed_m_s") + ": speeds must ascend, got " + formatValue(f.speed_m_s) + " after " +
+                  formatValue(fits.back().speed_m_s));
+    fits.push_back(f);
+  }
+  if (fits.empty()) throw Error(r.at("fit") + ": no rows");
+  return fits;
+}
+
+}  // namespace vdyn
