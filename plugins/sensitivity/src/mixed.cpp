@@ -266,6 +266,7 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
       x[k] << toEigen(sk.getQ()), toEigen(sk.getU());
     }
     X0.col(c) = (x[0] - x[1]) / (2 * h0);
+    if (std::getenv("VDYN_DEBUG_MIXED")) std::fprintf(stderr, "X0 col %d: %g %g\n", c, X0(0, c), X0(n - 1, c));
   }
 
   // --- coefficient matrices at grid points (shared by all levels) -----------
@@ -567,6 +568,7 @@ SimTK::State toEulerAngles(const Scene& scene, const SimTK::State& state) {
   scene.getMatter().convertToEulerAngles(state, se);
   sys.realize(se, SimTK::Stage::Instance);
   se.setTime(state.getTime());
+  se.updU() = state.getU();  // the u layout does not depend on the rotation coordinates
   if (state.getNZ()) se.updZ() = state.getZ();
   return se;
 }
