@@ -500,8 +500,16 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
     if (pass >= 1) {
       est = (R_cur - R_prev).cwiseAbs() + errInt;
       converged = true;
-      const double floor = 1e-14 * R_cur.cwiseAbs().maxCoeff();
-      for (int c = 0; c < r; ++c) converged &= est[c] <= set.tolerance * std::abs(R_cur[c]) + floor;
+      // A parameter whose normalized sensitivity |d psi / d b_i| s_i (s_i =
+      // max(|b_i|, scale_i)) is below 1e-3 of the largest is held to that
+      // floor instead of its own (near-zero) magnitude.
+      double normMax = 0;
+      for (int c = 0; c < r; ++c)
+        normMax = std::max(normMax, std::abs(R_cur[c]) * std::max(std::abs(b0[idx[c]]), params[idx[c]].scale));
+      for (int c = 0; c < r; ++c) {
+        const double si = std::max(std::abs(b0[idx[c]]), params[idx[c]].scale);
+        converged &= est[c] <= set.tolerance * std::max(std::abs(R_cur[c]), 1e-3 * normMax / si);
+      }
     }
     R_prev = R_cur;
     if (converged) break;
