@@ -508,7 +508,14 @@ TEST(TireParamsData, DefaultsMatchAppendixA) {
   const TireParams file =
       TireParams::fromParams(ParamReader::fromFile("appendix_a.json").child("tire").child("params"));
   const TireParams def;
-  for (const auto& [key, member] : TireParams::fields()) EXPECT_EQ(file.*member, def.*member) << key;
+  for (const auto& [key, member] : TireParams::fields()) {
+    if (std::string(key).rfind("relaxation_length", 0) == 0) continue;  // the file turns relaxation on
+    EXPECT_EQ(file.*member, def.*member) << key;
+  }
+  // Off by default (the seed's steady-slip tire), on in the App. A data file.
+  EXPECT_FALSE(def.hasRelaxation());
+  EXPECT_EQ(file.relaxation_length_longitudinal_m, 0.25);
+  EXPECT_EQ(file.relaxation_length_lateral_m, 0.5);
   EXPECT_EQ(def.unloaded_radius_m, 0.30);
   EXPECT_EQ(def.radial_stiffness_N_per_m, 1.5e5);
   EXPECT_EQ(def.longitudinal_stiffness_N, 8.0e4);
@@ -539,4 +546,46 @@ TEST(TireLinear, ForcesAreLinearInTheSlips) {
   // No saturation: at tan(alpha) = 5 the force is C_a atan 5 = 9.6e4 N, far above mu Fz.
   const TireForces f = m->calcForces(contact(*m, 4000.0, 10.0, 50.0, 10.0));
   EXPECT_DOUBLE_EQ(f.fy_N, -7.0e4 * std::atan(5.0));
+}
+
+// With relaxation, the force law is evaluated at the transient slips; at the
+// steady values kappa = (Omega Re - Vx) / |Vx|, tan alpha = Vy / |Vx| it must give
+// the steady-slip tire's forces exactly (driving, braking, both directions).
+TEST(TireRelaxation, TransientSlipAtItsSteadyValueGivesTheSteadyForces) {
+  TireParams p;
+  p.camber_stiffness_N_per_rad = 2e3;
+  TireParams pr = p;
+  pr.relaxation_length_longitudinal_m = 0.25;
+  pr.relaxation_length_lateral_m = 0.5;
+  for (const char* type : {"gim", "fiala", "linear"}) {
+    const auto steady = makeTireModel(type, p), lag = makeTireModel(type, pr);
+    for (double vx : {10.0, -7.0, 25.0})
+      for (double spinFactor : {0.9, 0.97, 1.0, 1.04, 1.3})
+        for (double vy : {-1.5, -0.2, 0.0, 0.3, 4.0}) {
+          ContactKinematics k;
+          k.deflection_m = 0.02;
+          k.vx_m_s = vx;
+          k.vy_m_s = vy;
+          k.camber_rad = 0.01;
+          const double Re = steady->calcRollingRadius(k.deflection_m);
+          k.spin_rad_s = spinFactor * vx / Re;
+          const TireForces f0 = steady->calcForces(k);
+          ContactKinematics kt = k;
+          kt.transient_slip = true;
+          kt.kappa = (k.spin_rad_s * Re - vx) / std::abs(vx);
+          kt.tan_alpha = vy / std::abs(vx);
+          const TireForces f1 = lag->calcForces(kt);
+          const double tol = 1e-9 * std::max(1.0, f0.fz_N);
+          EXPECT_NEAR(f1.fx_N, f0.fx_N, tol) << type << " vx " << vx << " spin " << spinFactor << " vy " << vy;
+          EXPECT_NEAR(f1.fy_N, f0.fy_N, tol) << type << " vx " << vx << " spin " << spinFactor << " vy " << vy;
+          EXPECT_NEAR(f1.mz_N_m, f0.mz_N_m, tol) << type;
+          EXPECT_NEAR(f1.slip_ratio, f0.slip_ratio, 1e-12) << type;
+        }
+  }
+}
+
+TEST(TireRelaxation, NegativeRelaxationLengthIsNamed) {
+  TireParams p;
+  p.relaxation_length_lateral_m = -0.1;
+  EXPECT_EQ(errorOf([&] { p.validate("tire"); }), "tire.relaxation_length_lateral_m must not be negative, got -0.1");
 }

@@ -14,8 +14,11 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
   const SimTK::MultibodySystem& system = scene.getSystem();
   const SimTK::SimbodyMatterSubsystem& matter = scene.getMatter();
   system.realize(state, SimTK::Stage::Instance);
-  SimTK::State se;  // the same configuration with Euler angles, so nq == nu for every mobilizer
-  matter.convertToEulerAngles(state, se);
+  // The same configuration with Euler angles, so nq == nu for every mobilizer
+  // (Simbody converts into an allocated state of the same system).
+  SimTK::State se = state;
+  if (!matter.getUseEulerAngles(state)) matter.convertToEulerAngles(state, se);
+  se.updZ() = state.getZ();  // Simbody 3.7's conversion resets z (u are zeroed below)
   system.realize(se, SimTK::Stage::Instance);
   se.updU() = 0;
   // With Euler angles there are no quaternion-normalization rows in qerr.
@@ -110,8 +113,9 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
   }
   res.multipliers = lambda;
   res.force_residual_all = residualForce;
-  SimTK::State out;
-  matter.convertToQuaternions(se, out);
+  SimTK::State out = se;
+  if (!matter.getUseEulerAngles(state)) matter.convertToQuaternions(se, out);
+  out.updZ() = se.getZ();
   out.updU() = 0;
   state = out;
   system.realize(state, SimTK::Stage::Position);

@@ -86,9 +86,18 @@ void plot(const std::vector<PlotSpec>& plots) {
       const Series& s = p.series[i];
       std::string y = "column(" + quote(s.y) + ")";
       if (!s.filter.empty()) {
-        const auto eq = s.filter.find('=');
-        y = "(strcol(" + quote(s.filter.substr(0, eq)) + ") eq " + quote(s.filter.substr(eq + 1)) + " ? " + y +
-            " : NaN)";
+        std::string cond;
+        std::size_t start = 0;
+        while (start <= s.filter.size()) {
+          const std::size_t end = std::min(s.filter.find(';', start), s.filter.size());
+          const std::string term = s.filter.substr(start, end - start);
+          const auto eq = term.find('=');
+          if (eq == std::string::npos) throw Error("plot filter '" + s.filter + "': expected column=value terms");
+          cond += (cond.empty() ? "" : " && ") + std::string("strcol(") + quote(term.substr(0, eq)) + ") eq " +
+                  quote(term.substr(eq + 1));
+          start = end + 1;
+        }
+        y = "((" + cond + ") ? " + y + " : NaN)";
       }
       g << (i ? ", \\\n     " : "") << quote(s.csv) << " using (column(" << quote(s.x) << ")):(" << y << ")"
         << (p.points ? " with linespoints lw 2 pt 7 title " : " with lines lw 2 title ") << quote(s.label);

@@ -35,7 +35,9 @@ struct Series {
   std::string csv;
   std::string x, y;   ///< column names
   std::string label;
-  std::string filter = ""; ///< optional "column=value": only rows where the column equals value
+  /// Optional "column=value[;column=value...]": only rows where every column
+  /// equals its value (compared as text).
+  std::string filter = "";
 };
 
 struct PlotSpec {

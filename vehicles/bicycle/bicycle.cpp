@@ -155,6 +155,7 @@ SimTK::State Bicycle::makeInitialState(double speed) const {
   front_.setOneU(s, 0, wf);
   rear_.setOneU(s, 0, wr);
   system.realize(s, SimTK::Stage::Velocity);
+  for (const TirePlugin* t : tires_) t->getForceElement().initializeRelaxationStates(s);
   return s;
 }
 

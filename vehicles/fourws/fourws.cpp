@@ -134,6 +134,7 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
   }
   for (int c = 0; c < 4; ++c) corners_[c].wheel.setOneU(s, 0, spin[c]);
   system.realize(s, SimTK::Stage::Velocity);
+  for (const TirePlugin* t : tires_) t->getForceElement().initializeRelaxationStates(s);
   return s;
 }
 

@@ -5,13 +5,26 @@ namespace vdyn {
 using SimTK::Vec3;
 
 SpeedHoldImpl::SpeedHoldImpl(SimTK::SimbodyMatterSubsystem& matter, const SimTK::MobilizedBody& chassis, double U0)
-    : Implementation(matter, 0, 1, 0), U0_(requirePositive(U0, "speed hold speed_m_s")) {
+    : Implementation(matter, 0, 1, 0), U0_(requirePositive(U0, "speed hold speed_m_s")), matter_(&matter) {
   G_ = addConstrainedBody(matter.Ground());  // so the ancestor frame is Ground
   B_ = addConstrainedBody(chassis);
 }
 
-Vec3 SpeedHoldImpl::direction(const SimTK::Rotation& R, const Vec3& v) const {
-  return (SimTK::dot(R.x(), v) * R.x() + SimTK::dot(R.y(), v) * R.y()) / U0_;
+void SpeedHoldImpl::realizeTopology(SimTK::State& s) const {
+  speedIndex_ = matter_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<double>(U0_));
+}
+
+double SpeedHoldImpl::getSpeed(const SimTK::State& s) const {
+  return SimTK::Value<double>::downcast(matter_->getDiscreteVariable(s, speedIndex_)).get();
+}
+
+void SpeedHoldImpl::setSpeed(SimTK::State& s, double U0) const {
+  requirePositive(U0, "speed hold speed_m_s");
+  SimTK::Value<double>::updDowncast(matter_->updDiscreteVariable(s, speedIndex_)).upd() = U0;
+}
+
+Vec3 SpeedHoldImpl::direction(const SimTK::Rotation& R, const Vec3& v, double U0) const {
+  return (SimTK::dot(R.x(), v) * R.x() + SimTK::dot(R.y(), v) * R.y()) / U0;
 }
 
 void SpeedHoldImpl::calcVelocityErrors(const SimTK::State& s,
@@ -21,7 +34,8 @@ void SpeedHoldImpl::calcVelocityErrors(const SimTK::State& s,
   const SimTK::Rotation& R = getBodyRotationFromState(s, B_);
   const Vec3& v = getBodyOriginVelocity(V_AB, B_);
   const double vx = SimTK::dot(R.x(), v), vy = SimTK::dot(R.y(), v);
-  verr[0] = (vx * vx + vy * vy - U0_ * U0_) / (2 * U0_);  // (3.18) / (2 U0)
+  const double U0 = getSpeed(s);
+  verr[0] = (vx * vx + vy * vy - U0 * U0) / (2 * U0);  // (3.18) / (2 U0)
 }
 
 void SpeedHoldImpl::calcVelocityDotErrors(const SimTK::State& s,
@@ -38,7 +52,7 @@ void SpeedHoldImpl::calcVelocityDotErrors(const SimTK::State& s,
   // d/dt (e . v) = (w x e) . v + e . a
   const double vxdot = SimTK::dot(SimTK::cross(w, ex), v) + SimTK::dot(ex, a);
   const double vydot = SimTK::dot(SimTK::cross(w, ey), v) + SimTK::dot(ey, a);
-  vaerr[0] = (vx * vxdot + vy * vydot) / U0_;
+  vaerr[0] = (vx * vxdot + vy * vydot) / getSpeed(s);
 }
 
 void SpeedHoldImpl::addInVelocityConstraintForces(
@@ -49,7 +63,7 @@ void SpeedHoldImpl::addInVelocityConstraintForces(
   const Vec3& v = getBodyOriginVelocityFromState(s, B_);
   // Power lambda * (d verr / d v) . v_dot-direction: the force is lambda times the
   // gradient of verr with respect to the chassis origin velocity.
-  addInStationForce(s, B_, Vec3(0), multipliers[0] * direction(R, v), bodyForcesInA);
+  addInStationForce(s, B_, Vec3(0), multipliers[0] * direction(R, v, getSpeed(s)), bodyForcesInA);
 }
 
 // ---------------------------------------------------------------------------
@@ -60,10 +74,22 @@ SpeedHoldPlugin::SpeedHoldPlugin(std::string name, std::string chassisBody, doub
 
 void SpeedHoldPlugin::DoAddTo(Scene& scene) {
   const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
-  constraint_ = SimTK::Constraint::Custom(new SpeedHoldImpl(scene.updMatter(), chassis, U0_));
+  auto* impl = new SpeedHoldImpl(scene.updMatter(), chassis, U0_);
+  constraint_ = SimTK::Constraint::Custom(impl);  // the constraint owns impl
+  impl_ = impl;
   const SpeedHoldPlugin* self = this;
   scene.addOutput({name() + ".force_N", "N", SimTK::Stage::Acceleration,
                    [self](const SimTK::State& s) { return self->calcForce(s); }});
+}
+
+double SpeedHoldPlugin::getSpeed(const SimTK::State& s) const {
+  if (!impl_) throw Error("speed hold '" + name() + "' is not part of a scene yet");
+  return impl_->getSpeed(s);
+}
+
+void SpeedHoldPlugin::setSpeed(SimTK::State& s, double U0) const {
+  if (!impl_) throw Error("speed hold '" + name() + "' is not part of a scene yet");
+  impl_->setSpeed(s, U0);
 }
 
 double SpeedHoldPlugin::calcForce(const SimTK::State& s) const {

@@ -55,7 +55,67 @@ TireForceImpl::Geometry TireForceImpl::calcGeometry(const SimTK::State& s) const
   return g;
 }
 
+void TireForceImpl::realizeTopology(SimTK::State& s) const {
+  if (!hasRelaxationStates()) return;
+  if (!zSub_) throw Error("tire force element with relaxation lengths needs a state subsystem (setStateSubsystem)");
+  z0_ = zSub_->allocateZ(s, SimTK::Vector(2, 0.0));
+}
+
 TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
+  TireContact c = calcContactKinematics(s);
+  if (!c.in_contact) return c;
+  if (hasRelaxationStates()) {
+    const TireParams& p = model_->params();
+    const SimTK::Vector& z = zSub_->getZ(s);
+    ContactKinematics& k = c.kinematics;
+    k.transient_slip = true;
+    if (p.relaxation_length_longitudinal_m > 0) k.kappa = -z[z0_] / p.relaxation_length_longitudinal_m;
+    if (p.relaxation_length_lateral_m > 0) k.tan_alpha = z[z0_ + 1] / p.relaxation_length_lateral_m;
+  }
+  c.forces = model_->calcForces(c.kinematics);
+  return c;
+}
+
+SimTK::Vec2 TireForceImpl::calcRelaxationRates(const SimTK::State& s) const {
+  SimTK::Vec2 rate(0);
+  if (!hasRelaxationStates()) return rate;
+  const TireParams& p = model_->params();
+  const TireContact c = calcContactKinematics(s);
+  const SimTK::Vector& z = zSub_->getZ(s);
+  // du/dt = v_slip - |Vx| u / sigma: the patch follows the slip displacement
+  // and relaxes to u = sigma v_slip / |Vx| (Pacejka's first-order transient).
+  // Off the ground the patch relaxes at the wheel's speed (or at rest, stays).
+  const ContactKinematics& k = c.kinematics;
+  const double V = std::abs(k.vx_m_s);
+  const double vsx = c.in_contact ? k.vx_m_s - k.spin_rad_s * model_->calcRollingRadius(k.deflection_m) : 0.0;
+  const double vsy = c.in_contact ? k.vy_m_s : 0.0;
+  if (p.relaxation_length_longitudinal_m > 0) rate[0] = vsx - V * z[z0_] / p.relaxation_length_longitudinal_m;
+  if (p.relaxation_length_lateral_m > 0) rate[1] = vsy - V * z[z0_ + 1] / p.relaxation_length_lateral_m;
+  return rate;
+}
+
+void TireForceImpl::realizeDynamics(const SimTK::State& s) const {
+  if (!hasRelaxationStates()) return;
+  const SimTK::Vec2 rate = calcRelaxationRates(s);
+  SimTK::Vector& zdot = zSub_->updZDot(s);
+  zdot[z0_] = rate[0];
+  zdot[z0_ + 1] = rate[1];
+}
+
+void TireForceImpl::initializeRelaxationStates(SimTK::State& s) const {
+  if (!hasRelaxationStates()) return;
+  const TireParams& p = model_->params();
+  const TireContact c = calcContactKinematics(s);
+  const ContactKinematics& k = c.kinematics;
+  const double den = std::max(std::abs(k.vx_m_s), p.low_speed_threshold_m_s);
+  const double vsx = c.in_contact ? k.vx_m_s - k.spin_rad_s * model_->calcRollingRadius(k.deflection_m) : 0.0;
+  const double vsy = c.in_contact ? k.vy_m_s : 0.0;
+  SimTK::Vector& z = zSub_->updZ(s);
+  z[z0_] = p.relaxation_length_longitudinal_m * vsx / den;
+  z[z0_ + 1] = p.relaxation_length_lateral_m * vsy / den;
+}
+
+TireContact TireForceImpl::calcContactKinematics(const SimTK::State& s) const {
   TireContact c;
   const Geometry g = calcGeometry(s);
   if (!g.in_contact) return c;
@@ -80,7 +140,6 @@ TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
   k.vy_m_s = SimTK::dot(v_slip, c.R_GC.y());
   k.spin_rad_s = SimTK::dot(w_GW, s_G);
   k.camber_rad = camber;
-  c.forces = model_->calcForces(k);
   return c;
 }
 
@@ -129,6 +188,7 @@ void TirePlugin::DoAddTo(Scene& scene) {
   const SimTK::MobilizedBody& wheel = scene.getBody(wheelBody_);
   auto road = scene.getService<const Road>(roadService_);
   auto* impl = new TireForceImpl(wheel, model_, road, spinAxis_W_, centre_W_, slipCentre_W_.value_or(centre_W_));
+  impl->setStateSubsystem(scene.updForces());
   SimTK::Force::Custom(scene.updForces(), impl);  // the subsystem owns impl
   impl_ = impl;
   const TireForceImpl* e = impl;

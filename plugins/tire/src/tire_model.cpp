@@ -33,6 +33,8 @@ void TireParams::validate(const std::string& w) const {
   requireNonNegative(rolling_resistance_coefficient, w + ".rolling_resistance_coefficient");
   requirePositive(low_speed_threshold_m_s, w + ".low_speed_threshold_m_s");
   requireInRange(rolling_radius_deflection_factor, 0.0, 1.0, w + ".rolling_radius_deflection_factor");
+  requireNonNegative(relaxation_length_longitudinal_m, w + ".relaxation_length_longitudinal_m");
+  requireNonNegative(relaxation_length_lateral_m, w + ".relaxation_length_lateral_m");
 }
 
 const std::vector<TireParams::Field>& TireParams::fields() {
@@ -49,6 +51,8 @@ const std::vector<TireParams::Field>& TireParams::fields() {
       {"rolling_resistance_coefficient", &TireParams::rolling_resistance_coefficient},
       {"low_speed_threshold_m_s", &TireParams::low_speed_threshold_m_s},
       {"rolling_radius_deflection_factor", &TireParams::rolling_radius_deflection_factor},
+      {"relaxation_length_longitudinal_m", &TireParams::relaxation_length_longitudinal_m},
+      {"relaxation_length_lateral_m", &TireParams::relaxation_length_lateral_m},
   };
   return f;
 }
@@ -102,7 +106,13 @@ TireModel::Slip TireModel::calcSlip(const ContactKinematics& k) const {
   s.vr = k.spin_rad_s * calcRollingRadius(k.deflection_m);
   s.vsx = k.vx_m_s - s.vr;
   s.den_x = std::max(std::abs(k.vx_m_s), p_.low_speed_threshold_m_s);
+  s.kappa = -s.vsx / s.den_x;
   s.sigma_y = k.vy_m_s / s.den_x;
+  s.transient = false;
+  if (k.transient_slip) {
+    if (p_.relaxation_length_longitudinal_m > 0) s.kappa = k.kappa, s.transient = true;
+    if (p_.relaxation_length_lateral_m > 0) s.sigma_y = k.tan_alpha, s.transient = true;
+  }
   if (p_.camber_stiffness_N_per_rad > 0 && p_.cornering_stiffness_N_per_rad > 0)
     s.sigma_y -= p_.camber_stiffness_N_per_rad / p_.cornering_stiffness_N_per_rad * std::sin(k.camber_rad);
   return s;
@@ -136,12 +146,27 @@ TireForces TireModel::calcForces(const ContactKinematics& k) const {
 void GimTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const {
   const Slip s = calcSlip(k);
   const double veps = p_.low_speed_threshold_m_s;
-  const bool braking = std::abs(s.vr) <= std::abs(k.vx_m_s);
-  const double den = braking ? s.den_x : std::max(std::abs(s.vr), veps);
-  const double Ss = std::min(1.0, std::abs(s.vsx) / den);
-  // Lateral slip: |tan alpha| in braking; (1 - S_s) |tan alpha| = |Vy| / |Omega Re| in driving.
-  const double Sa = braking ? std::abs(s.sigma_y) : std::abs(s.sigma_y) * s.den_x / den;
-  f.slip_ratio = -s.vsx / den;
+  double Ss, Sa, sx;  // comprehensive-slip components and the sign of the slip velocity
+  if (!s.transient) {
+    const bool braking = std::abs(s.vr) <= std::abs(k.vx_m_s);
+    const double den = braking ? s.den_x : std::max(std::abs(s.vr), veps);
+    Ss = std::min(1.0, std::abs(s.vsx) / den);
+    // Lateral slip: |tan alpha| in braking; (1 - S_s) |tan alpha| = |Vy| / |Omega Re| in driving.
+    Sa = braking ? std::abs(s.sigma_y) : std::abs(s.sigma_y) * s.den_x / den;
+    f.slip_ratio = -s.vsx / den;
+    sx = sgn(s.vsx);
+  } else {
+    // The same slips written in kappa = (Omega Re - Vx) / |Vx| and tan alpha:
+    // |Omega Re| / |Vx| = |dir + kappa| = r, braking when r <= 1, and the
+    // driving denominators |Omega Re| become r |Vx|.
+    const double dir = k.vx_m_s < 0 ? -1.0 : 1.0;
+    const double r = std::abs(dir + s.kappa);
+    const bool braking = r <= 1.0;
+    Ss = std::min(1.0, braking ? std::abs(s.kappa) : std::abs(s.kappa) / r);
+    Sa = braking ? std::abs(s.sigma_y) : std::abs(s.sigma_y) / r;
+    f.slip_ratio = braking ? s.kappa : s.kappa / r;
+    sx = -sgn(s.kappa);
+  }
   f.slip_angle_rad = std::atan(s.sigma_y);
   f.mu = calcFriction(std::hypot(Ss, Sa));
   const double muFz = f.mu * f.fz_N;
@@ -155,7 +180,7 @@ void GimTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const 
   const double sliding = 1.0 - 3.0 * ln2 + 2.0 * ln2 * ln;  // sliding-region share
   const double fxi = kx * ln2 + muFz * (kx / kk) * sliding;
   const double feta = ky * ln2 + muFz * (ky / kk) * sliding;
-  f.fx_N = -sgn(s.vsx) * fxi;
+  f.fx_N = -sx * fxi;
   f.fy_N = -sgn(s.sigma_y) * feta;
   // Aligning moment of the adhesion region (derived; equals Fiala's in pure
   // lateral slip): mu Fz a (1 - l_n) l_n^3 along the lateral share of the slip.
@@ -167,7 +192,7 @@ void GimTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const 
 // --- Fiala -------------------------------------------------------------------
 void FialaTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const {
   const Slip s = calcSlip(k);
-  const double kappa = -s.vsx / s.den_x;  // (Omega Re - Vx) / max(|Vx|, v_eps)
+  const double kappa = s.kappa;  // (Omega Re - Vx) / max(|Vx|, v_eps)
   const double tanA = s.sigma_y;
   f.slip_ratio = kappa;
   f.slip_angle_rad = std::atan(tanA);
@@ -191,7 +216,7 @@ void FialaTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) cons
 // --- Linear ------------------------------------------------------------------
 void LinearTire::DoCalcTangential(const ContactKinematics& k, TireForces& f) const {
   const Slip s = calcSlip(k);
-  f.slip_ratio = -s.vsx / s.den_x;
+  f.slip_ratio = s.kappa;
   f.slip_angle_rad = std::atan(s.sigma_y);
   f.mu = p_.mu_max;
   f.fx_N = p_.longitudinal_stiffness_N * f.slip_ratio;

@@ -29,19 +29,33 @@ class SpeedHoldImpl : public SimTK::Constraint::Custom::Implementation {
   void addInVelocityConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
                                      SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
                                      SimTK::Array_<SimTK::Real, SimTK::ConstrainedUIndex>& mobilityForces) const override;
+  /// Allocates the held speed as an Instance-stage state variable (default U0).
+  void realizeTopology(SimTK::State& s) const override;
+
+  /// The speed U0 held in this state, m/s.
+  double getSpeed(const SimTK::State& s) const;
+  /// Changes U0 in this state (> 0, m/s); invalidates Stage::Instance and above.
+  void setSpeed(SimTK::State& s, double speed_m_s) const;
 
  private:
   /// Unit-free direction (v_xi e_xi + v_eta e_eta) / U0 in A for a chassis velocity.
-  SimTK::Vec3 direction(const SimTK::Rotation& R_AB, const SimTK::Vec3& v_AB) const;
+  SimTK::Vec3 direction(const SimTK::Rotation& R_AB, const SimTK::Vec3& v_AB, double U0) const;
   SimTK::ConstrainedBodyIndex G_, B_;
-  double U0_;
+  double U0_;  // default
+  const SimTK::SimbodyMatterSubsystem* matter_;
+  mutable SimTK::DiscreteVariableIndex speedIndex_;
 };
 
 class SpeedHoldPlugin : public ConstraintPlugin {
  public:
   /// speed_m_s > 0: the forward speed U0 held on the named chassis body.
   SpeedHoldPlugin(std::string name, std::string chassisBody, double speed_m_s);
+  /// The default speed (the one a new state holds), m/s.
   double speed() const { return U0_; }
+  /// The speed held in `s`, and a way to change it without rebuilding the scene
+  /// (continuation in speed); valid once the plugin is in a scene.
+  double getSpeed(const SimTK::State& s) const;
+  void setSpeed(SimTK::State& s, double speed_m_s) const;
   /// Force the constraint applies along the direction of travel, N (needs
   /// Stage::Acceleration).
   double calcForce(const SimTK::State& s) const;
@@ -53,6 +67,7 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   std::string chassis_;
   double U0_;
   SimTK::Constraint::Custom constraint_;
+  const SpeedHoldImpl* impl_ = nullptr;
 };
 
 /// Registers "speed_hold": {"chassis": "chassis", "speed_m_s": 10}.

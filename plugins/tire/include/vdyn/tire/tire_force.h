@@ -38,8 +38,23 @@ class TireForceImpl : public SimTK::Force::Custom::Implementation {
                 std::shared_ptr<const Road> road, const SimTK::UnitVec3& spinAxis_W, const SimTK::Vec3& centre_W,
                 const SimTK::Vec3& slipCentre_W);
 
+  /// A tire with relaxation lengths keeps its two contact-patch deflections
+  /// u_x, u_y (m) as continuous states (z) of `stateSubsystem` (the scene's
+  /// force subsystem); call before the system's topology is realized.
+  void setStateSubsystem(const SimTK::Subsystem& stateSubsystem) { zSub_ = &stateSubsystem; }
+  bool hasRelaxationStates() const { return model_->params().hasRelaxation(); }
+
   /// Needs Stage::Velocity (and Time) realized.
   TireContact calcContact(const SimTK::State& state) const;
+  /// Sets the patch deflections to the steady-state slip of the current
+  /// velocities (u = sigma * slip), so a run starts without a transient in the
+  /// tire; a no-op without relaxation. Needs Stage::Velocity realized.
+  void initializeRelaxationStates(SimTK::State& state) const;
+  /// d(u_x, u_y)/dt at this state (zero where the relaxation length is 0).
+  SimTK::Vec2 calcRelaxationRates(const SimTK::State& state) const;
+
+  void realizeTopology(SimTK::State& state) const override;
+  void realizeDynamics(const SimTK::State& state) const override;  // z rates (a Dynamics-stage quantity)
 
   void calcForce(const SimTK::State& state, SimTK::Vector_<SimTK::SpatialVec>& bodyForces,
                  SimTK::Vector_<SimTK::Vec3>& particleForces, SimTK::Vector& mobilityForces) const override;
@@ -57,17 +72,22 @@ class TireForceImpl : public SimTK::Force::Custom::Implementation {
   };
   /// Geometry only (Stage::Position): contact point, frame, deflection.
   Geometry calcGeometry(const SimTK::State& s) const;
+  /// Kinematics without the transient slips (Stage::Velocity).
+  TireContact calcContactKinematics(const SimTK::State& s) const;
 
   SimTK::MobilizedBody wheel_;
   std::shared_ptr<const TireModel> model_;
   std::shared_ptr<const Road> road_;
   SimTK::UnitVec3 spinAxis_W_;
   SimTK::Vec3 centre_W_, slipCentre_W_;
+  const SimTK::Subsystem* zSub_ = nullptr;
+  mutable SimTK::ZIndex z0_;  // u_x at z0_, u_y at z0_ + 1 (set in realizeTopology)
 };
 
 /// Tire plugin: attaches a TireModel to a named wheel body of the scene, on the
 /// scene's "road" service. Outputs (per instance name N): N.Fx_N, N.Fy_N, N.Fz_N,
-/// N.Mz_N_m, N.deflection_m, N.slip_ratio, N.slip_angle_rad.
+/// N.Mz_N_m, N.deflection_m, N.slip_ratio, N.slip_angle_rad. With relaxation
+/// lengths the tire carries two continuous states (patch deflections, m).
 class TirePlugin : public ForceElementPlugin {
  public:
   TirePlugin(std::string type, std::string name, std::string wheelBody,

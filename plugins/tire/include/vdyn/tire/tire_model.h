@@ -34,6 +34,17 @@ struct TireParams {
   /// Speed below which slip denominators are held at this value, m/s: slips stay
   /// finite at standstill and the tire acts as a stiff damper there.
   double low_speed_threshold_m_s = 0.5;
+  /// Relaxation lengths, m (not in the seed; 0 = off, the seed's steady-state
+  /// slip). When > 0, the slip of that direction is a state: the contact-patch
+  /// deflection u obeys du/dt = v_slip - |Vx| u / sigma (first-order "stretched
+  /// string" transient, Pacejka, Tire and Vehicle Dynamics, ch. 7), and the
+  /// steady force law is evaluated at the transient slip u / sigma. The steady
+  /// state is unchanged; the tire lags by sigma / |Vx| and, at standstill, acts
+  /// as a spring instead of the threshold damper.
+  double relaxation_length_longitudinal_m = 0.0;
+  double relaxation_length_lateral_m = 0.0;
+
+  bool hasRelaxation() const { return relaxation_length_longitudinal_m > 0 || relaxation_length_lateral_m > 0; }
 
   /// Throws Error naming `where`.field and the value for a non-physical value.
   void validate(const std::string& where = "tire") const;
@@ -54,6 +65,12 @@ struct ContactKinematics {
   double vy_m_s = 0;               ///< wheel-centre velocity along y_C
   double spin_rad_s = 0;           ///< wheel spin about its axis, > 0 rolling forward
   double camber_rad = 0;           ///< > 0 when the wheel top leans toward +y_C
+  /// Transient slips from the relaxation states (used only where the matching
+  /// relaxation length is > 0): kappa = -u_x / sigma_x (> 0 driving),
+  /// tan_alpha = u_y / sigma_y (> 0 sliding toward +y_C).
+  bool transient_slip = false;
+  double kappa = 0;
+  double tan_alpha = 0;
 };
 
 /// Forces on the wheel in C, and slip diagnostics.
@@ -92,7 +109,9 @@ class TireModel {
     double vr;      ///< rolling speed Omega Re
     double vsx;     ///< longitudinal slip velocity Vx - Omega Re
     double den_x;   ///< max(|Vx|, v_eps)
-    double sigma_y; ///< signed lateral slip: Vy / den_x - (C_g / C_a) sin(gamma)
+    double kappa;   ///< longitudinal slip, -vsx / den_x (or the transient slip)
+    double sigma_y; ///< signed lateral slip: Vy / den_x (or the transient tan alpha) - (C_g / C_a) sin(gamma)
+    bool transient; ///< a relaxation state supplied kappa or sigma_y
   };
   Slip calcSlip(const ContactKinematics& k) const;
   /// Friction coefficient falling linearly from mu_max (S = 0) to mu_min (S >= 1).

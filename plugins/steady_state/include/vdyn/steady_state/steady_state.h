@@ -1,0 +1,200 @@
+#pragma once
+// The seed's general steady-state analysis (chapter 3, DESIGN.md section 3) on a
+// Simbody scene, its continuation, stability verdict and sensitivity.
+//
+// The state is split into zero, ineffective and effective variables by a
+// SteadyStateProblem that the vehicle and manoeuvre declare (the solver knows no
+// vehicle). In the Euler-angle form of the state (every mobilizer has nq = nu),
+// the unknowns are
+//     x = [ q_e (effective coordinates), u_e (effective speeds),
+//           lambda (multipliers of every constraint), z (auxiliary states) ]
+// and the equations are
+//     f(q, u) - M udot_s(q, u) - G^T lambda = 0   every mobility    (3.9)-(3.11)
+//     Psi(q) = 0                                   position constraints (3.12)
+//     nonholonomic velocity constraints, e.g. the speed (3.18)
+//     zdot = 0                                      auxiliary states (tire lag)
+// with udot_s the accelerations of steady motion, functions of the velocities
+// (3.19). f - M udot_s is Simbody's inverse dynamics
+// (calcResidualForceIgnoringConstraints): no forward dynamics is needed. Zero
+// variables (u not listed as effective) are held at 0; ineffective coordinates
+// keep their values. Newton-Raphson with a finite-difference Jacobian
+// (3.15)-(3.17) (columns of lambda are exact: -G^T), rank-one (Broyden) updates
+// between fresh Jacobians, and a backtracking line search on a scaled merit.
+#include <complex>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Dense>
+#include <Simbody.h>
+
+#include "vdyn/core/error.h"
+#include "vdyn/core/scene.h"
+
+namespace vdyn {
+
+/// Declared by the vehicle / manoeuvre. Indices refer to the Euler-angle state
+/// (SimbodyMatterSubsystem::convertToEulerAngles), where nq == nu.
+struct SteadyStateProblem {
+  /// Time at which time-dependent inputs (steering commands, road) are
+  /// evaluated, s: a time after every command has settled.
+  double time_s = 0;
+  /// Ineffective coordinates: q indices that keep their values (e.g. the
+  /// chassis x, y, yaw and the wheel spin angles).
+  std::vector<int> ineffective_q;
+  /// Effective generalized speeds (unknowns); every other u is a zero variable.
+  std::vector<int> effective_u;
+  /// Steady accelerations udot_s(q, u) (3.19), given Stage::Velocity; all zero
+  /// when empty.
+  std::function<void(const SimTK::State&, SimTK::Vector& udot)> calc_steady_udot;
+  /// A free-mobilizer base whose yaw and horizontal position the dynamics do
+  /// not depend on (flat road). The stability analysis linearises in a frame
+  /// that turns with it; invalid = no such symmetry.
+  SimTK::MobilizedBodyIndex floating_base;
+  /// Coordinates the stability analysis leaves out besides the base's x, y and
+  /// yaw: ones no force depends on (wheel spin angles). Euler-state q indices.
+  std::vector<int> cyclic_q;
+};
+
+/// A steady turn of a vehicle with a free-mobilizer chassis on a flat road:
+/// ineffective chassis x, y, yaw (the third body-XYZ angle) and wheel spin
+/// angles; effective chassis yaw rate, horizontal velocity and wheel spin rates;
+/// every other speed zero; chassis acceleration w x v (3.19).
+SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::string& chassisBody,
+                                            const std::vector<std::string>& wheelBodies, double time_s);
+
+struct SteadyStateOptions {
+  double force_tolerance = 1e-6;       ///< max |generalized-force residual|, N or N m
+  double position_tolerance = 1e-12;   ///< max |position-constraint error|, m or rad
+  double velocity_tolerance = 1e-12;   ///< max |velocity-constraint error|, m/s
+  double rate_tolerance = 1e-12;       ///< max |zdot| (units of z per second)
+  int max_iterations = 60;
+  /// Rank-one updates between finite-difference Jacobians (far fewer residual
+  /// evaluations); a fresh Jacobian is taken whenever a step fails to descend.
+  bool broyden = true;
+  /// Start every solve (also resolve() in a continuation) with a fresh
+  /// Jacobian: Newton's quadratic convergence from a good start (2-4
+  /// iterations) for ~n extra residual evaluations. Off: the previous solve's
+  /// updated Jacobian is reused (fewer evaluations, more iterations).
+  bool fresh_jacobian_each_solve = true;
+};
+
+/// Thrown when the solver does not converge: the message names the iterations,
+/// the residual norms and the worst equation.
+class SteadyStateError : public Error {
+ public:
+  using Error::Error;
+};
+
+struct SteadyStateResult {
+  SimTK::State state;              ///< the steady state (quaternion form), realized to Velocity
+  SimTK::State euler_state;        ///< the same in Euler-angle form (restart point)
+  int iterations = 0;              ///< Newton iterations
+  int jacobians = 0;               ///< finite-difference Jacobians taken
+  int residual_evaluations = 0;
+  double force_residual = 0;       ///< max |f - M udot_s - G^T lambda|, N
+  double position_error = 0;       ///< max |Psi|
+  double velocity_error = 0;       ///< max |nonholonomic error|
+  double rate_residual = 0;        ///< max |zdot|
+  double residual_norm = 0;        ///< scaled 2-norm of all equations
+  SimTK::Vector multipliers;       ///< lambda (Simbody's order and sign)
+  double wall_time_s = 0;
+};
+
+struct StabilityResult {
+  bool stable = false;
+  /// The eigenvalue with the largest real part (1/s): its real part is the
+  /// slowest decay rate (or growth, if > 0).
+  std::complex<double> least_damped;
+  std::vector<std::complex<double>> eigenvalues;
+  int dimension = 0;               ///< independent states linearised
+  double equilibrium_residual = 0; ///< max |reduced state rate| at the point (should be ~0)
+};
+
+class SteadyStateSolver {
+ public:
+  SteadyStateSolver(const Scene& scene, SteadyStateProblem problem, SteadyStateOptions options = {});
+
+  /// Solves from `guess` (any state of the scene; its velocities and
+  /// coordinates are the start). Throws SteadyStateError if it does not converge.
+  SteadyStateResult solve(const SimTK::State& guess);
+  /// Re-solves from a previous result (e.g. after a condition changed); keeps
+  /// the last Jacobian as the first one when Broyden updates are on.
+  SteadyStateResult resolve(const SteadyStateResult& previous);
+  /// Forces a fresh finite-difference Jacobian at the next solve.
+  void invalidateJacobian() { haveJacobian_ = false; }
+
+  /// Linearises the equations of motion about a steady state (central finite
+  /// differences of Simbody's forward dynamics) on the constraint manifold, in
+  /// the frame turning with the floating base, and returns the eigenvalues.
+  /// Stable when every real part is below -tolerance_per_s.
+  StabilityResult calcStability(const SteadyStateResult& steady, double tolerance_per_s = 1e-6) const;
+
+  const SteadyStateProblem& problem() const { return problem_; }
+  const SteadyStateOptions& options() const { return opt_; }
+  SteadyStateOptions& updOptions() { return opt_; }
+
+  /// Unknowns of the Euler-angle state `se` with multipliers `lambda`, and back.
+  Eigen::VectorXd getUnknowns(const SimTK::State& se, const SimTK::Vector& lambda) const;
+  /// Writes unknowns x into a result used as a start for resolve().
+  void setGuess(const Eigen::VectorXd& x, SteadyStateResult& guess) const;
+  /// The equations at unknowns x, unscaled (for tests).
+  Eigen::VectorXd calcEquations(const Eigen::VectorXd& x) const;
+  int numUnknowns() const { return n_; }
+
+ private:
+  void setUnknowns(const Eigen::VectorXd& x) const;
+  SteadyStateResult solveFrom(SimTK::State se, const SimTK::Vector& lambda0);
+  void calcJacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& r, Eigen::MatrixXd& J) const;
+  std::string describeEquation(int row) const;
+
+  const Scene& scene_;
+  SteadyStateProblem problem_;
+  SteadyStateOptions opt_;
+  std::vector<int> qAll_;     // q indices in use (Euler state)
+  std::vector<int> qe_, ue_;  // effective q and u (Euler state)
+  int nq_ = 0, nu_ = 0, nz_ = 0, mp_ = 0, mv_ = 0, m_ = 0, n_ = 0;
+  Eigen::VectorXd xScale_, rScale_;  // typical sizes of unknowns; equation weights
+  mutable SimTK::State se_;           // workspace (Euler-angle form)
+  mutable int evaluations_ = 0;
+  Eigen::MatrixXd J_;
+  bool haveJacobian_ = false;
+};
+
+/// One point of a continuation.
+struct ContinuationPoint {
+  double value = 0;           ///< the driving condition
+  bool converged = false;
+  std::string failure;        ///< the solver's message when not converged
+  SteadyStateResult result;   ///< valid when converged
+};
+
+struct ContinuationOptions {
+  /// A failed step is retried as up to this many halvings from the last
+  /// converged point before the point is declared without a steady state.
+  int max_bisections = 4;
+  /// After a point fails, report the remaining values as beyond the branch's
+  /// end instead of solving them from a distant start (which can land on
+  /// another, unrelated branch).
+  bool stop_at_branch_end = true;
+};
+
+/// Follows the steady state as a driving condition takes `values` in turn:
+/// `setCondition(state, value)` applies it (e.g. a speed, a steering angle);
+/// each solve starts from the previous solutions extrapolated along the branch
+/// (linear through two, quadratic through three converged points).
+std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, const SimTK::State& start,
+                                                 const std::vector<double>& values,
+                                                 const std::function<void(SimTK::State&, double)>& setCondition,
+                                                 const ContinuationOptions& options = {});
+
+/// Steady-state sensitivity (4.47)-(4.49): d outputs / d p by central
+/// differences of converged solutions at p0 +- h. With no h given, h =
+/// scale * cbrt(1e-10) (the solver's relative precision, ~1e-10, balanced against
+/// the O(h^2) truncation), scale = max(|p0|, typical).
+std::vector<double> calcSteadyStateSensitivity(
+    SteadyStateSolver& solver, const SteadyStateResult& nominal, double p0, double typical,
+    const std::function<void(SimTK::State&, double)>& setCondition,
+    const std::function<std::vector<double>(const SimTK::State&)>& outputs, double h = 0);
+
+}  // namespace vdyn

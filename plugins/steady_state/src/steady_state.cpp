@@ -1,0 +1,646 @@
+#include "vdyn/steady_state/steady_state.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+namespace {
+double maxAbs(const Eigen::VectorXd& v) { return v.size() ? v.lpNorm<Eigen::Infinity>() : 0.0; }
+bool contains(const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); }
+/// Copies `in` (realized to Instance here) into Euler-angle (or quaternion) form.
+SimTK::State toEulerAngles(const SimTK::MultibodySystem& system, const SimTK::SimbodyMatterSubsystem& matter,
+                           const SimTK::State& in) {
+  SimTK::State s = in;
+  system.realize(s, SimTK::Stage::Instance);
+  if (matter.getUseEulerAngles(s)) return s;
+  SimTK::State out = s;  // Simbody converts into an allocated state of the same system
+  matter.convertToEulerAngles(s, out);
+  // Simbody 3.7 re-realizes the output's Model stage, which resets u and z:
+  // copy them (and the time) over.
+  out.setTime(s.getTime());
+  out.updU() = s.getU();
+  out.updZ() = s.getZ();
+  system.realize(out, SimTK::Stage::Instance);
+  return out;
+}
+SimTK::State toQuaternions(const SimTK::MultibodySystem& system, const SimTK::SimbodyMatterSubsystem& matter,
+                           const SimTK::State& in) {
+  SimTK::State s = in;
+  system.realize(s, SimTK::Stage::Instance);
+  if (!matter.getUseEulerAngles(s)) return s;
+  SimTK::State out = s;
+  matter.convertToQuaternions(s, out);
+  // Simbody 3.7 re-realizes the output's Model stage, which resets u and z:
+  // copy them (and the time) over.
+  out.setTime(s.getTime());
+  out.updU() = s.getU();
+  out.updZ() = s.getZ();
+  system.realize(out, SimTK::Stage::Instance);
+  return out;
+}
+}  // namespace
+
+SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::string& chassisBody,
+                                            const std::vector<std::string>& wheelBodies, double time_s) {
+  const SimTK::MobilizedBody& chassis = scene.getBody(chassisBody);
+  const SimTK::State se = toEulerAngles(scene.getSystem(), scene.getMatter(), scene.getDefaultState());
+  if (chassis.getNumQ(se) != 6 || chassis.getNumU(se) != 6)
+    throw Error("steady turning: chassis '" + chassisBody + "' must be on a free mobilizer (6 q and 6 u), has " +
+                std::to_string(chassis.getNumU(se)) + " u");
+  SteadyStateProblem p;
+  p.time_s = requireFinite(time_s, "steady turning time_s");
+  const int q0 = chassis.getFirstQIndex(se), u0 = chassis.getFirstUIndex(se);
+  // Free mobilizer, Euler form: q = [body-XYZ angles, position], u = [w_G, v_G].
+  p.ineffective_q = {q0 + 2, q0 + 3, q0 + 4};  // third XYZ angle (yaw), x, y
+  p.effective_u = {u0 + 2, u0 + 3, u0 + 4};    // yaw rate, horizontal velocity
+  for (const auto& name : wheelBodies) {
+    const SimTK::MobilizedBody& w = scene.getBody(name);
+    if (w.getNumQ(se) != 1 || w.getNumU(se) != 1)
+      throw Error("steady turning: wheel '" + name + "' must be on a one-coordinate (spin) mobilizer");
+    p.ineffective_q.push_back(w.getFirstQIndex(se));
+    p.cyclic_q.push_back(w.getFirstQIndex(se));
+    p.effective_u.push_back(w.getFirstUIndex(se));
+  }
+  p.floating_base = chassis.getMobilizedBodyIndex();
+  // (3.19): a steady turn at yaw rate w moves the chassis origin on a circle,
+  // its velocity turning with it: a = w x v; every other acceleration is zero.
+  p.calc_steady_udot = [u0](const SimTK::State& s, SimTK::Vector& udot) {
+    const SimTK::Vector& u = s.getU();
+    const Vec3 w(u[u0], u[u0 + 1], u[u0 + 2]), v(u[u0 + 3], u[u0 + 4], u[u0 + 5]);
+    const Vec3 a = SimTK::cross(w, v);
+    for (int i = 0; i < 3; ++i) udot[u0 + 3 + i] = a[i];
+  };
+  return p;
+}
+
+// ---------------------------------------------------------------------------
+SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem problem, SteadyStateOptions options)
+    : scene_(scene), problem_(std::move(problem)), opt_(options) {
+  const SimTK::MultibodySystem& system = scene_.getSystem();
+  se_ = toEulerAngles(system, scene_.getMatter(), scene_.getDefaultState());
+  // In Euler-angle form every mobilizer has as many q as u; Simbody keeps the
+  // q vector at its quaternion size, so the coordinates in use are listed.
+  const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
+  for (SimTK::MobilizedBodyIndex b(1); b < matter.getNumBodies(); ++b) {
+    const SimTK::MobilizedBody& mb = matter.getMobilizedBody(b);
+    if (mb.getNumQ(se_) != mb.getNumU(se_))
+      throw Error("steady state: mobilizer of body " + std::to_string(int(b)) + " has nq != nu in Euler-angle form");
+    for (int i = 0; i < mb.getNumQ(se_); ++i) qAll_.push_back(mb.getFirstQIndex(se_) + i);
+  }
+  nq_ = int(qAll_.size());
+  nu_ = se_.getNU();
+  nz_ = se_.getNZ();
+  if (nq_ != nu_)
+    throw Error("steady state: the Euler-angle state has nq (" + std::to_string(nq_) + ") != nu (" + std::to_string(nu_) + ")");
+  mp_ = se_.getNQErr();
+  mv_ = se_.getNUErr() - mp_;
+  m_ = se_.getNMultipliers();
+  if (se_.getNUDotErr() != mp_ + mv_)
+    throw Error("steady state: acceleration-only constraints are not supported (" +
+                std::to_string(se_.getNUDotErr() - mp_ - mv_) + " found)");
+  for (int i : problem_.ineffective_q)
+    if (!contains(qAll_, i)) throw Error("steady state: ineffective q index " + std::to_string(i) + " is not a coordinate in use");
+  for (int i : problem_.effective_u)
+    if (i < 0 || i >= nu_) throw Error("steady state: effective u index " + std::to_string(i) + " out of range");
+  for (int i : qAll_)
+    if (!contains(problem_.ineffective_q, i)) qe_.push_back(i);
+  ue_ = problem_.effective_u;
+  std::sort(ue_.begin(), ue_.end());
+  ue_.erase(std::unique(ue_.begin(), ue_.end()), ue_.end());
+  if (int(qe_.size() + ue_.size()) != nu_)
+    throw Error("steady state: effective coordinates (" + std::to_string(qe_.size()) + ") plus effective speeds (" +
+                std::to_string(ue_.size()) + ") must equal the number of mobilities (" + std::to_string(nu_) +
+                ") so that unknowns and equations match");
+  n_ = nu_ + m_ + nz_;
+  // Typical sizes of the unknowns (finite-difference steps) and weights that
+  // bring every equation to newtons (merit and convergence report).
+  xScale_.resize(n_);
+  int k = 0;
+  for (std::size_t i = 0; i < qe_.size(); ++i) xScale_[k++] = 0.1;  // m or rad
+  for (std::size_t i = 0; i < ue_.size(); ++i) xScale_[k++] = 1.0;  // m/s or rad/s
+  for (int i = 0; i < m_; ++i) xScale_[k++] = 1e3;                    // N
+  for (int i = 0; i < nz_; ++i) xScale_[k++] = 1e-3;                  // tire lag states, m
+  rScale_.resize(n_);
+  rScale_.head(nu_).setConstant(1.0);
+  rScale_.segment(nu_, mp_).setConstant(1e6);     // N per m of constraint error
+  rScale_.segment(nu_ + mp_, mv_).setConstant(1e4);  // N per m/s
+  rScale_.tail(nz_).setConstant(1e5);             // N per m/s of patch-deflection rate
+}
+
+Eigen::VectorXd SteadyStateSolver::getUnknowns(const SimTK::State& se, const SimTK::Vector& lambda) const {
+  Eigen::VectorXd x(n_);
+  int k = 0;
+  for (int i : qe_) x[k++] = se.getQ()[i];
+  for (int i : ue_) x[k++] = se.getU()[i];
+  for (int i = 0; i < m_; ++i) x[k++] = i < lambda.size() ? lambda[i] : 0.0;
+  for (int i = 0; i < nz_; ++i) x[k++] = se.getZ()[i];
+  return x;
+}
+
+void SteadyStateSolver::setGuess(const Eigen::VectorXd& x, SteadyStateResult& guess) const {
+  assert(x.size() == n_);
+  SimTK::State& g = guess.euler_state;
+  int k = 0;
+  for (int i : qe_) g.updQ()[i] = x[k++];
+  for (int i : ue_) g.updU()[i] = x[k++];
+  guess.multipliers.resize(m_);
+  for (int i = 0; i < m_; ++i) guess.multipliers[i] = x[k++];
+  for (int i = 0; i < nz_; ++i) g.updZ()[i] = x[k++];
+}
+
+void SteadyStateSolver::setUnknowns(const Eigen::VectorXd& x) const {
+  // Touch only what changed, so Simbody keeps the stages that are still valid.
+  int k = 0;
+  bool qChanged = false, uChanged = false, zChanged = false;
+  for (int i : qe_) qChanged |= se_.getQ()[i] != x[k++];
+  for (int i : ue_) uChanged |= se_.getU()[i] != x[k++];
+  k += m_;
+  for (int i = 0; i < nz_; ++i) zChanged |= se_.getZ()[i] != x[k++];
+  k = 0;
+  if (qChanged) {
+    SimTK::Vector& q = se_.updQ();
+    for (int i : qe_) q[i] = x[k++];
+  } else {
+    k += int(qe_.size());
+  }
+  if (uChanged) {
+    SimTK::Vector& u = se_.updU();
+    for (int i : ue_) u[i] = x[k++];
+  } else {
+    k += int(ue_.size());
+  }
+  k += m_;
+  if (zChanged) {
+    SimTK::Vector& z = se_.updZ();
+    for (int i = 0; i < nz_; ++i) z[i] = x[k++];
+  }
+}
+
+Eigen::VectorXd SteadyStateSolver::calcEquations(const Eigen::VectorXd& x) const {
+  ++evaluations_;
+  setUnknowns(x);
+  const SimTK::MultibodySystem& system = scene_.getSystem();
+  const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
+  system.realize(se_, SimTK::Stage::Dynamics);
+  SimTK::Vector udot(nu_, 0.0), residual, gtl;
+  if (problem_.calc_steady_udot) problem_.calc_steady_udot(se_, udot);
+  matter.calcResidualForceIgnoringConstraints(se_, system.getMobilityForces(se_, SimTK::Stage::Dynamics),
+                                              system.getRigidBodyForces(se_, SimTK::Stage::Dynamics), udot,
+                                              residual);
+  if (m_) {
+    SimTK::Vector lambda(m_);
+    for (int i = 0; i < m_; ++i) lambda[i] = x[nu_ + i];
+    matter.multiplyByGTranspose(se_, lambda, gtl);
+    residual += gtl;  // M udot - f + G^T lambda (Simbody's sign)
+  }
+  Eigen::VectorXd r(n_);
+  for (int i = 0; i < nu_; ++i) r[i] = residual[i];
+  for (int i = 0; i < mp_; ++i) r[nu_ + i] = se_.getQErr()[i];
+  for (int i = 0; i < mv_; ++i) r[nu_ + mp_ + i] = se_.getUErr()[mp_ + i];
+  for (int i = 0; i < nz_; ++i) r[nu_ + m_ + i] = se_.getZDot()[i];
+  return r;
+}
+
+void SteadyStateSolver::calcJacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& r, Eigen::MatrixXd& J) const {
+  J.resize(n_, n_);
+  // Multiplier columns are exact: d r / d lambda = [G^T; 0].
+  calcEquations(x);  // leaves the workspace at x
+  SimTK::Vector e(m_, 0.0), col;
+  for (int j = 0; j < m_; ++j) {
+    e[j] = 1.0;
+    scene_.getMatter().multiplyByGTranspose(se_, e, col);
+    e[j] = 0.0;
+    J.col(nu_ + j).setZero();
+    for (int i = 0; i < nu_; ++i) J(i, nu_ + j) = col[i];
+  }
+  // The others by forward differences (3.16): step sqrt(eps) of the typical size.
+  for (int j = 0; j < n_; ++j) {
+    if (j >= nu_ && j < nu_ + m_) continue;
+    const double h = 1.5e-8 * std::max(std::abs(x[j]), xScale_[j]);
+    Eigen::VectorXd xp = x;
+    xp[j] += h;
+    J.col(j) = (calcEquations(xp) - r) / h;
+  }
+  setUnknowns(x);
+}
+
+std::string SteadyStateSolver::describeEquation(int row) const {
+  if (row < nu_) {
+    const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
+    for (SimTK::MobilizedBodyIndex b(0); b < matter.getNumBodies(); ++b) {
+      const SimTK::MobilizedBody& mb = matter.getMobilizedBody(b);
+      const int u0 = mb.getFirstUIndex(se_);
+      if (row >= u0 && row < u0 + mb.getNumU(se_))
+        return "generalized force u[" + std::to_string(row) + "] (mobilizer of body " + std::to_string(int(b)) +
+               ", its u " + std::to_string(row - u0) + ")";
+    }
+    return "generalized force u[" + std::to_string(row) + "]";
+  }
+  if (row < nu_ + mp_) return "position constraint error " + std::to_string(row - nu_);
+  if (row < nu_ + m_) return "velocity constraint error " + std::to_string(row - nu_ - mp_);
+  return "auxiliary state rate zdot[" + std::to_string(row - nu_ - m_) + "]";
+}
+
+SteadyStateResult SteadyStateSolver::solve(const SimTK::State& guess) {
+  const SimTK::State se = toEulerAngles(scene_.getSystem(), scene_.getMatter(), guess);
+  haveJacobian_ = false;
+  return solveFrom(se, SimTK::Vector(m_, 0.0));
+}
+
+SteadyStateResult SteadyStateSolver::resolve(const SteadyStateResult& previous) {
+  return solveFrom(previous.euler_state, previous.multipliers);
+}
+
+SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vector& lambda0) {
+  const auto t0 = std::chrono::steady_clock::now();
+  const SimTK::MultibodySystem& system = scene_.getSystem();
+  se.setTime(problem_.time_s);
+  // Zero variables are zero; the remaining state is the start.
+  {
+    SimTK::Vector u(nu_, 0.0);
+    for (int i : ue_) u[i] = se.getU()[i];
+    se.updU() = u;
+  }
+  system.realize(se, SimTK::Stage::Instance);
+  if (se.getNQ() != se_.getNQ() || se.getNU() != nu_ || se.getNZ() != nz_)
+    throw Error("steady state: the start state does not belong to the solver's scene");
+  se_ = se;
+  se_.invalidateAll(SimTK::Stage::Position);  // commands may have changed (model parameters)
+  evaluations_ = 0;
+
+  SteadyStateResult res;
+  Eigen::VectorXd x = getUnknowns(se_, lambda0);
+  Eigen::VectorXd r = calcEquations(x);
+  auto merit = [&](const Eigen::VectorXd& rr) { return rr.cwiseProduct(rScale_).norm(); };
+  auto blocks = [&](const Eigen::VectorXd& rr, double& f, double& p, double& v, double& z) {
+    f = maxAbs(rr.head(nu_));
+    p = maxAbs(rr.segment(nu_, mp_));
+    v = maxAbs(rr.segment(nu_ + mp_, mv_));
+    z = maxAbs(rr.tail(nz_));
+  };
+  auto converged = [&](const Eigen::VectorXd& rr) {
+    double f, p, v, z;
+    blocks(rr, f, p, v, z);
+    return f <= opt_.force_tolerance && p <= opt_.position_tolerance && v <= opt_.velocity_tolerance &&
+           z <= opt_.rate_tolerance;
+  };
+  const bool debug = std::getenv("VDYN_DEBUG_STEADY") != nullptr;
+  bool fresh = false;  // J_ was computed at the current x
+  if (!haveJacobian_ || !opt_.broyden || opt_.fresh_jacobian_each_solve) {
+    calcJacobian(x, r, J_);
+    ++res.jacobians;
+    haveJacobian_ = fresh = true;
+  }
+  bool stalled = false;
+  for (res.iterations = 0; !converged(r); ++res.iterations) {
+    if (res.iterations == opt_.max_iterations) break;
+    // Equilibrated solve: rows to newtons, columns to typical sizes.
+    const Eigen::MatrixXd Js = rScale_.asDiagonal() * J_ * xScale_.asDiagonal();
+    Eigen::VectorXd dx = xScale_.cwiseProduct(Js.partialPivLu().solve(-r.cwiseProduct(rScale_)));
+    if (!dx.allFinite()) dx.setZero();
+    const double m0 = merit(r);
+    double alpha = 1.0;
+    Eigen::VectorXd xn, rn;
+    bool decreased = false;
+    for (int ls = 0; ls < 30 && !decreased && dx.squaredNorm() > 0; ++ls) {
+      xn = x + alpha * dx;
+      rn = calcEquations(xn);
+      decreased = rn.allFinite() && merit(rn) < (1.0 - 1e-4 * alpha) * m0;
+      if (!decreased) alpha *= 0.5;
+    }
+    if (debug)
+      std::fprintf(stderr, "steady: it %d alpha %g merit %.3e -> %.3e%s\n", res.iterations, alpha, m0,
+                   decreased ? merit(rn) : m0, fresh ? " (fresh J)" : "");
+    if (!decreased) {
+      if (fresh) {
+        stalled = true;
+        break;
+      }
+      calcJacobian(x, r, J_);  // the updated Jacobian misled the step: take a fresh one
+      ++res.jacobians;
+      fresh = true;
+      continue;
+    }
+    if (opt_.broyden) {
+      // Good Broyden update: J += (dr - J dx) dx^T / (dx^T dx), in scaled unknowns.
+      const Eigen::VectorXd s = xn - x, y = rn - r;
+      const Eigen::VectorXd ss = s.cwiseQuotient(xScale_);
+      J_ += ((y - J_ * s) * ss.cwiseQuotient(xScale_).transpose()) / ss.squaredNorm();
+      fresh = false;
+      // A slow step (merit reduced by less than half) asks for a fresh Jacobian next time.
+      if (merit(rn) > 0.5 * m0) {
+        calcJacobian(xn, rn, J_);
+        ++res.jacobians;
+        fresh = true;
+      }
+    } else {
+      x = xn;
+      r = rn;
+      calcJacobian(x, r, J_);
+      ++res.jacobians;
+      continue;
+    }
+    x = xn;
+    r = rn;
+  }
+  r = calcEquations(x);
+  blocks(r, res.force_residual, res.position_error, res.velocity_error, res.rate_residual);
+  res.residual_norm = merit(r);
+  res.residual_evaluations = evaluations_;
+  if (!converged(r)) {
+    haveJacobian_ = false;
+    Eigen::Index worst;
+    r.cwiseProduct(rScale_).cwiseAbs().maxCoeff(&worst);
+    throw SteadyStateError(
+        std::string("steady state did not converge") + (stalled ? " (no descent along the Newton direction)" : "") +
+        ": " + std::to_string(res.iterations) + " iterations, scaled residual norm " + formatValue(res.residual_norm) +
+        ", max force residual " + formatValue(res.force_residual) + " N (tolerance " +
+        formatValue(opt_.force_tolerance) + "), max position-constraint error " + formatValue(res.position_error) +
+        ", max velocity-constraint error " + formatValue(res.velocity_error) + ", max zdot " +
+        formatValue(res.rate_residual) + "; worst equation: " + describeEquation(int(worst)) + " = " +
+        formatValue(r[worst]));
+  }
+  res.multipliers.resize(m_);
+  for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nu_ + i];
+  res.euler_state = se_;
+  res.state = toQuaternions(system, scene_.getMatter(), se_);
+  system.realize(res.state, SimTK::Stage::Velocity);
+  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+// --- stability -----------------------------------------------------------------
+namespace {
+/// Reduced coordinates of a state modulo the base's yaw and horizontal
+/// position: base height, ZYX roll and pitch, base velocities in the yawed frame,
+/// every other q (but the cyclic ones) and u, and z.
+struct Reduction {
+  const SimTK::MultibodySystem* system;
+  const SimTK::SimbodyMatterSubsystem* matter;
+  SimTK::MobilizedBodyIndex base;
+  int bq0 = -1, bu0 = -1;
+  std::vector<int> qs, us;  // other coordinates and speeds kept
+  int nz = 0;
+  int size() const { return (base.isValid() ? 9 : 0) + int(qs.size() + us.size()) + nz; }
+
+  Eigen::VectorXd fromState(const SimTK::State& s) const {
+    Eigen::VectorXd r(size());
+    int k = 0;
+    if (base.isValid()) {
+      const SimTK::MobilizedBody& mb = matter->getMobilizedBody(base);
+      const Vec3 a = mb.getBodyRotation(s).convertThreeAxesRotationToThreeAngles(
+          SimTK::BodyRotationSequence, SimTK::ZAxis, SimTK::YAxis, SimTK::XAxis);  // yaw, pitch, roll
+      const SimTK::Rotation Rz(-a[0], SimTK::ZAxis);
+      const SimTK::Vector& u = s.getU();
+      const Vec3 w = Rz * Vec3(u[bu0], u[bu0 + 1], u[bu0 + 2]), v = Rz * Vec3(u[bu0 + 3], u[bu0 + 4], u[bu0 + 5]);
+      r[k++] = s.getQ()[bq0 + 5];  // height
+      r[k++] = a[2];
+      r[k++] = a[1];
+      for (int i = 0; i < 3; ++i) r[k++] = w[i];
+      for (int i = 0; i < 3; ++i) r[k++] = v[i];
+    }
+    for (int i : qs) r[k++] = s.getQ()[i];
+    for (int i : us) r[k++] = s.getU()[i];
+    for (int i = 0; i < nz; ++i) r[k++] = s.getZ()[i];
+    return r;
+  }
+  /// Writes r into s at zero yaw (x, y and cyclic coordinates kept).
+  void toState(const Eigen::VectorXd& r, SimTK::State& s) const {
+    int k = 0;
+    if (base.isValid()) {
+      const SimTK::MobilizedBody& mb = matter->getMobilizedBody(base);
+      const double z = r[k++], roll = r[k++], pitch = r[k++];
+      mb.setQToFitRotation(s, SimTK::Rotation(SimTK::BodyRotationSequence, pitch, SimTK::YAxis, roll, SimTK::XAxis));
+      s.updQ()[bq0 + 5] = z;
+      for (int i = 0; i < 6; ++i) s.updU()[bu0 + i] = r[k++];
+    }
+    for (int i : qs) s.updQ()[i] = r[k++];
+    for (int i : us) s.updU()[i] = r[k++];
+    for (int i = 0; i < nz; ++i) s.updZ()[i] = r[k++];
+  }
+  /// d r / dt from Simbody's forward dynamics at a state with zero yaw.
+  Eigen::VectorXd rate(SimTK::State& s) const {
+    system->realize(s, SimTK::Stage::Acceleration);
+    Eigen::VectorXd d(size());
+    int k = 0;
+    if (base.isValid()) {
+      const SimTK::Vector& u = s.getU();
+      const SimTK::Vector& udot = s.getUDot();
+      const Vec3 w(u[bu0], u[bu0 + 1], u[bu0 + 2]), v(u[bu0 + 3], u[bu0 + 4], u[bu0 + 5]);
+      const SimTK::MobilizedBody& mb = matter->getMobilizedBody(base);
+      const Vec3 a = mb.getBodyRotation(s).convertThreeAxesRotationToThreeAngles(
+          SimTK::BodyRotationSequence, SimTK::ZAxis, SimTK::YAxis, SimTK::XAxis);
+      const double pitch = a[1];
+      // ZYX rates at zero yaw: w = (roll' cos(pitch), pitch', yaw' - roll' sin(pitch)).
+      const double rollDot = w[0] / std::cos(pitch), pitchDot = w[1], yawDot = w[2] + rollDot * std::sin(pitch);
+      const Vec3 ez(0, 0, 1);
+      const Vec3 wdot = Vec3(udot[bu0], udot[bu0 + 1], udot[bu0 + 2]) - yawDot * SimTK::cross(ez, w);
+      const Vec3 vdot = Vec3(udot[bu0 + 3], udot[bu0 + 4], udot[bu0 + 5]) - yawDot * SimTK::cross(ez, v);
+      d[k++] = s.getQDot()[bq0 + 5];
+      d[k++] = rollDot;
+      d[k++] = pitchDot;
+      for (int i = 0; i < 3; ++i) d[k++] = wdot[i];
+      for (int i = 0; i < 3; ++i) d[k++] = vdot[i];
+    }
+    for (int i : qs) d[k++] = s.getQDot()[i];
+    for (int i : us) d[k++] = s.getUDot()[i];
+    for (int i = 0; i < nz; ++i) d[k++] = s.getZDot()[i];
+    return d;
+  }
+};
+}  // namespace
+
+StabilityResult SteadyStateSolver::calcStability(const SteadyStateResult& steady, double tol) const {
+  const SimTK::MultibodySystem& system = scene_.getSystem();
+  const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
+  SimTK::State s = steady.euler_state;
+  system.realize(s, SimTK::Stage::Instance);
+  Reduction red;
+  red.system = &system;
+  red.matter = &matter;
+  red.base = problem_.floating_base;
+  std::vector<int> skipQ = problem_.cyclic_q, skipU;
+  if (red.base.isValid()) {
+    const SimTK::MobilizedBody& mb = matter.getMobilizedBody(red.base);
+    red.bq0 = mb.getFirstQIndex(s);
+    red.bu0 = mb.getFirstUIndex(s);
+    for (int i = 0; i < 6; ++i) skipQ.push_back(red.bq0 + i), skipU.push_back(red.bu0 + i);
+  }
+  for (int i : qAll_)
+    if (!contains(skipQ, i)) red.qs.push_back(i);
+  for (int i = 0; i < nu_; ++i)
+    if (!contains(skipU, i)) red.us.push_back(i);
+  red.nz = nz_;
+  // Start from the steady state at zero yaw.
+  system.realize(s, SimTK::Stage::Position);
+  const Eigen::VectorXd r0 = red.fromState(s);
+  red.toState(r0, s);
+  const int N = red.size();
+
+  // Tangent space of the constraint manifold: null space of d[qerr; uerr]/dr.
+  const int nc = s.getNQErr() + s.getNUErr();
+  Eigen::MatrixXd C(nc, N);
+  auto constraintErrors = [&](SimTK::State& st) {
+    system.realize(st, SimTK::Stage::Velocity);
+    Eigen::VectorXd c(nc);
+    for (int i = 0; i < st.getNQErr(); ++i) c[i] = st.getQErr()[i];
+    for (int i = 0; i < st.getNUErr(); ++i) c[st.getNQErr() + i] = st.getUErr()[i];
+    return c;
+  };
+  for (int j = 0; j < N; ++j) {
+    const double h = 1e-7;
+    Eigen::VectorXd rp = r0, rm = r0;
+    rp[j] += h;
+    rm[j] -= h;
+    red.toState(rp, s);
+    const Eigen::VectorXd cp = constraintErrors(s);
+    red.toState(rm, s);
+    C.col(j) = (cp - constraintErrors(s)) / (2 * h);
+  }
+  Eigen::MatrixXd T;
+  if (nc > 0) {
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(C, Eigen::ComputeFullV);
+    const auto& sv = svd.singularValues();
+    int rank = 0;
+    for (int i = 0; i < sv.size(); ++i) rank += sv[i] > 1e-8 * sv[0];
+    T = svd.matrixV().rightCols(N - rank);
+  } else {
+    T = Eigen::MatrixXd::Identity(N, N);
+  }
+  const int D = int(T.cols());
+  // A = T^T (d rate / d r) T by central differences along the tangent directions.
+  red.toState(r0, s);
+  StabilityResult out;
+  out.dimension = D;
+  out.equilibrium_residual = maxAbs(red.rate(s));
+  Eigen::MatrixXd JT(N, D);
+  const double h = 1e-6;
+  for (int j = 0; j < D; ++j) {
+    red.toState(r0 + h * T.col(j), s);
+    const Eigen::VectorXd dp = red.rate(s);
+    red.toState(r0 - h * T.col(j), s);
+    JT.col(j) = (dp - red.rate(s)) / (2 * h);
+  }
+  const Eigen::MatrixXd A = T.transpose() * JT;
+  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
+  double maxRe = -1e300;
+  for (int i = 0; i < D; ++i) {
+    const std::complex<double> ev = es.eigenvalues()[i];
+    out.eigenvalues.push_back(ev);
+    if (ev.real() > maxRe) maxRe = ev.real(), out.least_damped = ev;
+  }
+  std::sort(out.eigenvalues.begin(), out.eigenvalues.end(),
+            [](const auto& a, const auto& b) { return a.real() > b.real(); });
+  out.stable = D == 0 || maxRe < -tol;
+  return out;
+}
+
+// --- continuation and sensitivity ------------------------------------------------
+std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, const SimTK::State& start,
+                                                 const std::vector<double>& values,
+                                                 const std::function<void(SimTK::State&, double)>& setCondition,
+                                                 const ContinuationOptions& options) {
+  std::vector<ContinuationPoint> out;
+  // Converged points along the branch (values and solutions), latest last;
+  // intermediate points of a bisected step are kept here but not reported.
+  std::vector<std::pair<double, SteadyStateResult>> branch;
+  auto predict = [&](double v, SteadyStateResult& guess) {
+    // Lagrange extrapolation through the last (up to three) branch points.
+    const std::size_t k = std::min<std::size_t>(3, branch.size());
+    if (k < 2) return;
+    std::vector<double> vs;
+    std::vector<Eigen::VectorXd> xs;
+    for (std::size_t i = branch.size() - k; i < branch.size(); ++i) {
+      vs.push_back(branch[i].first);
+      xs.push_back(solver.getUnknowns(branch[i].second.euler_state, branch[i].second.multipliers));
+    }
+    for (std::size_t i = 0; i < k; ++i)
+      for (std::size_t j = i + 1; j < k; ++j)
+        if (vs[i] == vs[j]) return;
+    Eigen::VectorXd xp = Eigen::VectorXd::Zero(xs[0].size());
+    for (std::size_t i = 0; i < k; ++i) {
+      double w = 1;
+      for (std::size_t j = 0; j < k; ++j)
+        if (j != i) w *= (v - vs[j]) / (vs[i] - vs[j]);
+      xp += w * xs[i];
+    }
+    solver.setGuess(xp, guess);
+  };
+  auto solveAt = [&](double v) {
+    if (branch.empty()) {
+      SimTK::State s = start;
+      setCondition(s, v);
+      return solver.solve(s);
+    }
+    SteadyStateResult guess = branch.back().second;
+    setCondition(guess.euler_state, v);
+    predict(v, guess);
+    return solver.resolve(guess);
+  };
+  bool ended = false;
+  for (double v : values) {
+    ContinuationPoint p;
+    p.value = v;
+    if (ended) {
+      p.failure = "the branch ended before this value (no steady state found by continuation)";
+      out.push_back(std::move(p));
+      continue;
+    }
+    // Try the full step; on failure, reach v by halving the step from the
+    // last converged point, up to max_bisections times.
+    double target = v;
+    int halvings = 0;
+    while (true) {
+      try {
+        SteadyStateResult r = solveAt(target);
+        branch.emplace_back(target, r);
+        if (target == v) {
+          p.result = std::move(r);
+          p.converged = true;
+          break;
+        }
+        target = v;  // an intermediate point converged: try the rest
+      } catch (const Error& e) {
+        if (branch.empty() || halvings == options.max_bisections) {
+          p.failure = e.what();
+          break;
+        }
+        ++halvings;
+        target = branch.back().first + 0.5 * (target - branch.back().first);
+      }
+    }
+    if (!p.converged && options.stop_at_branch_end && !branch.empty()) ended = true;
+    out.push_back(std::move(p));
+  }
+  return out;
+}
+
+std::vector<double> calcSteadyStateSensitivity(
+    SteadyStateSolver& solver, const SteadyStateResult& nominal, double p0, double typical,
+    const std::function<void(SimTK::State&, double)>& setCondition,
+    const std::function<std::vector<double>(const SimTK::State&)>& outputs, double h) {
+  requireFinite(p0, "steady-state sensitivity parameter value");
+  if (h <= 0) h = std::max(std::abs(p0), std::abs(typical)) * std::cbrt(1e-10);
+  requirePositive(h, "steady-state sensitivity step h");
+  auto at = [&](double p) {
+    SteadyStateResult g = nominal;
+    setCondition(g.euler_state, p);
+    const SteadyStateResult r = solver.resolve(g);
+    return outputs(r.state);
+  };
+  const std::vector<double> fp = at(p0 + h), fm = at(p0 - h);
+  // Leave the scene's condition at its nominal value.
+  SteadyStateResult g = nominal;
+  setCondition(g.euler_state, p0);
+  std::vector<double> d(fp.size());
+  for (std::size_t i = 0; i < fp.size(); ++i) d[i] = (fp[i] - fm[i]) / (2 * h);  // (4.49)
+  return d;
+}
+
+}  // namespace vdyn

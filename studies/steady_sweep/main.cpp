@@ -1,0 +1,165 @@
+// steady_sweep: steady turning of the App. A 4WS vehicle over speeds x front
+// steering angles by continuation (plugins/steady_state): path radius, side
+// slip, yaw rate, stability and Newton iterations per point, with the rear
+// wheels at zero and at a given ratio of the front angle. Points with no
+// converged steady state are reported as such (no numbers).
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+
+#include "study.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/steady_state/steady_state.h"
+#include "vdyn/steering/adjustable_hold.h"
+#include "vdyn/vehicles/fourws.h"
+
+using namespace vdyn;
+
+namespace {
+std::vector<double> range(double a, double b, double step, const std::string& what) {
+  requirePositive(step, what + " step");
+  if (!(b >= a)) throw Error(what + ": the end (" + formatValue(b) + ") is below the start (" + formatValue(a) + ")");
+  std::vector<double> v;
+  for (int i = 0; a + i * step <= b + 1e-9 * step; ++i) v.push_back(a + i * step);
+  return v;
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  return study::run("steady_sweep", [&] {
+    namespace po = study::po;
+    po::options_description opts("Options");
+    opts.add_options()("data", po::value<std::string>()->default_value("appendix_a.json"), "vehicle data file")(
+        "speed-min-m-s", po::value<double>()->default_value(5.0), "lowest speed, m/s")(
+        "speed-max-m-s", po::value<double>()->default_value(30.0), "highest speed, m/s")(
+        "speed-step-m-s", po::value<double>()->default_value(2.5), "speed step, m/s")(
+        "front-min-deg", po::value<double>()->default_value(0.5), "smallest front angle, deg")(
+        "front-max-deg", po::value<double>()->default_value(6.0), "largest front angle, deg")(
+        "front-step-deg", po::value<double>()->default_value(0.5), "front angle step, deg")(
+        "rear-ratio", po::value<double>()->default_value(0.25),
+        "rear/front steering ratio of the second sweep (the first has the rear at 0)")("no-plots", "skip the PNG plots");
+    const auto vm = study::parse("steady_sweep", "steady turning over speed x front steering angle by continuation", argc,
+                                 argv, opts);
+    const double deg = SimTK::Pi / 180;
+    const auto speeds = range(vm["speed-min-m-s"].as<double>(), vm["speed-max-m-s"].as<double>(),
+                              vm["speed-step-m-s"].as<double>(), "--speed-min-m-s .. --speed-max-m-s");
+    const auto fronts = range(vm["front-min-deg"].as<double>(), vm["front-max-deg"].as<double>(),
+                              vm["front-step-deg"].as<double>(), "--front-min-deg .. --front-max-deg");
+    for (double U : speeds) requirePositive(U, "--speed-min-m-s");
+    const double ratio = requireFinite(vm["rear-ratio"].as<double>(), "--rear-ratio");
+    const std::string out = study::outputDir(vm, "steady_sweep");
+
+    FourWsVehicle car(FourWsParams::fromFile(vm["data"].as<std::string>()));
+    auto front = std::make_shared<AdjustableHoldCommand>(0.0), rear = std::make_shared<AdjustableHoldCommand>(0.0);
+    car.addAxleSteering("front_steer", true, front);
+    car.addAxleSteering("rear_steer", false, rear);
+    const auto& hold = static_cast<const SpeedHoldPlugin&>(
+        car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", speeds.front())));
+    const Scene& sc = car.getScene();
+    SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
+
+    const std::string csv = out + "/sweep.csv";
+    std::ofstream f(csv);
+    f << "rear_ratio,speed_m_s,front_deg,rear_deg,status,path_radius_m,side_slip_rad,yaw_rate_rad_s,"
+         "lateral_acceleration_m_s2,iterations,least_damped_real_per_s,least_damped_imag_per_s\n";
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<int> iterations;
+    int points = 0, stable = 0, unstable = 0, none = 0;
+    double solveTime = 0, stabilityTime = 0;
+    Json byRatio = Json::array();
+    std::printf("steady_sweep: %zu speeds x %zu front angles x rear ratios {0, %g}\n", speeds.size(), fronts.size(), ratio);
+    std::printf("  %6s %6s  %s\n", "ratio", "U m/s", "largest front angle with a stable steady state (deg); median iterations");
+    for (double kr : {0.0, ratio}) {
+      Json rows = Json::array();
+      for (double U : speeds) {
+        SimTK::State start = car.makeInitialState(U);
+        hold.setSpeed(start, U);
+        const auto ts = std::chrono::steady_clock::now();
+        // The branch starts at straight running (0 deg: the initial state is
+        // its solution) and follows the front angle up.
+        std::vector<double> values = {0.0};
+        values.insert(values.end(), fronts.begin(), fronts.end());
+        auto pts = followSteadyState(solver, start, values, [&](SimTK::State&, double fdeg) {
+          front->setAngle(fdeg * deg);
+          rear->setAngle(kr * fdeg * deg);
+        });
+        if (!pts.front().converged) throw Error("steady_sweep: straight running at " + formatValue(U) + " m/s did not converge: " + pts.front().failure);
+        pts.erase(pts.begin());
+        solveTime += std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
+        double largestStable = 0;
+        std::vector<int> its;
+        for (const auto& p : pts) {
+          ++points;
+          f << kr << ',' << U << ',' << p.value << ',' << kr * p.value << ',';
+          if (!p.converged) {
+            ++none;
+            f << "no_steady_state,,,,,,,\n";
+            continue;
+          }
+          const auto tst = std::chrono::steady_clock::now();
+          const StabilityResult st = solver.calcStability(p.result);
+          stabilityTime += std::chrono::duration<double>(std::chrono::steady_clock::now() - tst).count();
+          const double r = sc.evalOutput("chassis.yaw_rate_rad_s", p.result.state);
+          (st.stable ? stable : unstable)++;
+          if (st.stable) largestStable = std::max(largestStable, p.value);
+          iterations.push_back(p.result.iterations);
+          its.push_back(p.result.iterations);
+          f << (st.stable ? "stable" : "unstable") << ',' << U / r << ','
+            << sc.evalOutput("chassis.side_slip_rad", p.result.state) << ',' << r << ',' << U * r << ','
+            << p.result.iterations << ',' << st.least_damped.real() << ',' << st.least_damped.imag() << '\n';
+        }
+        std::sort(its.begin(), its.end());
+        std::printf("  %6g %6g  %5.2f; %d\n", kr, U, largestStable, its.empty() ? -1 : its[its.size() / 2]);
+        std::fflush(stdout);
+        rows.push_back({{"speed_m_s", U}, {"largest_stable_front_deg", largestStable}});
+      }
+      byRatio.push_back({{"rear_ratio", kr}, {"speeds", rows}});
+    }
+    f.close();
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    std::sort(iterations.begin(), iterations.end());
+    const double median = iterations.empty() ? -1 : iterations[iterations.size() / 2];
+    study::writeJson(out + "/summary.json", {{"points", points},
+                                             {"stable_points", stable},
+                                             {"unstable_points", unstable},
+                                             {"no_steady_state_points", none},
+                                             {"median_iterations_per_point", median},
+                                             {"max_iterations_per_point", iterations.empty() ? -1 : iterations.back()},
+                                             {"solve_wall_time_s", solveTime},
+                                             {"stability_wall_time_s", stabilityTime},
+                                             {"wall_time_s", wall},
+                                             {"by_rear_ratio", byRatio}});
+    std::printf("  %d points: %d stable, %d unstable, %d without a steady state; median %g Newton iterations per point\n",
+                points, stable, unstable, none, median);
+    std::printf("  wall time %.2f s (solves %.2f s, stability %.2f s)\n", wall, solveTime, stabilityTime);
+    if (!vm.count("no-plots")) {
+      std::vector<study::PlotSpec> plots;
+      for (double kr : {0.0, ratio}) {
+        const std::string tag = kr == 0 ? "rear0" : "ratio";
+        char title[64];
+        std::snprintf(title, sizeof title, "rear/front = %g", kr);
+        std::vector<study::Series> rad, slip;
+        for (double U : speeds) {
+          char filt[64], lab[32];
+          std::snprintf(filt, sizeof filt, "rear_ratio=%g;speed_m_s=%g", kr, U);
+          std::snprintf(lab, sizeof lab, "%g m/s", U);
+          rad.push_back({csv, "front_deg", "path_radius_m", lab, filt});
+          slip.push_back({csv, "front_deg", "side_slip_rad", lab, filt});
+        }
+        study::PlotSpec pr{out + "/radius_" + tag + ".png", std::string("Steady path radius, ") + title,
+                           "front steering angle (deg)", "path radius (m)", rad};
+        pr.logy = true;
+        pr.points = true;
+        study::PlotSpec ps{out + "/side_slip_" + tag + ".png", std::string("Steady side slip, ") + title,
+                           "front steering angle (deg)", "side slip (rad)", slip};
+        ps.points = true;
+        plots.push_back(pr);
+        plots.push_back(ps);
+      }
+      study::plot(plots);
+    }
+    std::printf("  output: %s\n", out.c_str());
+  });
+}
