@@ -24,13 +24,27 @@ int main(int argc, char** argv) {
                        "integrator accuracies swept (fd methods; mixed with tolerance = accuracy)")(
         "repeats", po::value<int>()->default_value(1), "runs per point (median)")(
         "scaling-accuracy", po::value<double>()->default_value(1e-6), "accuracy of the parameter-count sweep")(
-        "skip-sweep", "only the parameter-count sweep")("no-plots", "skip the PNG");
+        "skip-sweep", "only the parameter-count sweep")(
+        "tire-relaxation", po::value<std::string>(),
+        "on or off (default: ch4_sensitivity.json's tire_relaxation.enabled)")("no-plots", "skip the PNG");
     const auto vm = study::parse("ch4_sensitivity_cost", "sensitivity run time against error and parameter count",
                                  argc, argv, opts);
     const std::string out = study::outputDir(vm, "benchmarks");
     const int repeats = vm["repeats"].as<int>();
+    // The study's data: quarter car, tire variant, reference settings.
+    const ParamReader data = ParamReader::fromFile("ch4_sensitivity.json");
+    const ParamReader relax = data.child("tire_relaxation");
+    bool relaxation = relax.boolean("enabled");
+    if (vm.count("tire-relaxation")) relaxation = vm["tire-relaxation"].as<std::string>() == "on";
+    QuarterCarParams qp = QuarterCarParams::fromFile(data.string("vehicle_data"));
+    qp.tire.relaxation_length_longitudinal_m = relaxation ? relax.number("longitudinal_m") : 0.0;
+    qp.tire.relaxation_length_lateral_m = relaxation ? relax.number("lateral_m") : 0.0;
+    SensitivitySettings refSet;
+    refSet.reference_accuracy = data.child("reference").number("accuracy");
+    refSet.reference_perturbation = data.child("reference").number("perturbation");
+    std::printf("ch4_sensitivity_cost: quarter car, %s tire\n", relaxation ? "relaxation-length" : "steady-slip");
     SensitivityProblem p;
-    auto model = QuarterCarDesign::fromFile("quarter_car.json");
+    auto model = std::make_shared<QuarterCarDesign>(qp);
     p.model = model;
     p.parameters = {"m1", "m3", "K", "D", "Cz", "s'"};
     p.cost = CostFunctional::parse("integral_of_square:chassis.az_m_s2");
@@ -47,7 +61,7 @@ int main(int argc, char** argv) {
     };
 
     if (!vm.count("skip-sweep")) {
-      const SensitivityResult ref = makeSensitivityMethod("reference")->compute(p);
+      const SensitivityResult ref = makeSensitivityMethod("reference", refSet)->compute(p);
       std::ofstream csv(out + "/ch4_sensitivity_cost.csv");
       csv << "method,accuracy,max_rel_error,wall_time_s\n";
       struct Row { std::string m; double acc, err, t; };

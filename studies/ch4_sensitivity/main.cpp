@@ -58,7 +58,11 @@ int main(int argc, char** argv) {
         "reference-accuracy", po::value<double>(), "reference: integrator relative accuracy")(
         "perturbation", po::value<double>(), "finite differences: relative perturbation (default: rule from the accuracy)")(
         "params", po::value<std::string>(), "comma list of design parameter names (default: the data file's)")(
-        "t-end-s", po::value<double>(), "cost horizon T, s")("no-plots", "skip the PNG plots");
+        "t-end-s", po::value<double>(), "cost horizon T, s")(
+        "tire-relaxation", po::value<std::string>(),
+        "quarter car: on (relaxation-length tire, lengths from the data file's tire_relaxation) or off (the "
+        "seed's steady-slip tire); default: the data file's tire_relaxation.enabled")(
+        "no-plots", "skip the PNG plots");
     const auto vm = study::parse("ch4_sensitivity", "design sensitivity d psi / d b by finite differences, the mixed "
                                  "method and a reference", argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
@@ -66,8 +70,27 @@ int main(int argc, char** argv) {
 
     SensitivityProblem prob;
     std::string seedNote;
+    bool relaxation = false;
+    QuarterCarParams quarterCar;
     if (vehicle == "quarter_car") {
-      prob.model = QuarterCarDesign::fromFile(data.string("vehicle_data"));
+      QuarterCarParams qp = QuarterCarParams::fromFile(data.string("vehicle_data"));
+      const ParamReader relax = data.child("tire_relaxation");
+      relaxation = relax.boolean("enabled");
+      if (vm.count("tire-relaxation")) {
+        const std::string v = vm["tire-relaxation"].as<std::string>();
+        if (v != "on" && v != "off") throw Error("--tire-relaxation must be on or off, got '" + v + "'");
+        relaxation = v == "on";
+      }
+      if (relaxation) {
+        qp.tire.relaxation_length_longitudinal_m =
+            requirePositive(relax.number("longitudinal_m"), relax.at("longitudinal_m"));
+        qp.tire.relaxation_length_lateral_m = requirePositive(relax.number("lateral_m"), relax.at("lateral_m"));
+      } else {
+        qp.tire.relaxation_length_longitudinal_m = 0;
+        qp.tire.relaxation_length_lateral_m = 0;
+      }
+      prob.model = std::make_shared<QuarterCarDesign>(qp);
+      quarterCar = qp;
       prob.parameters = stringList(data, "design_parameters");
       prob.cost = costOf(data.child("cost"));
       prob.t_end_s = data.number("t_end_s");
@@ -125,6 +148,7 @@ int main(int argc, char** argv) {
     const auto idx = prob.parameterIndices();
     Json summary;
     summary["vehicle"] = vehicle;
+    if (vehicle == "quarter_car") summary["tire"] = relaxation ? "relaxation_length" : "steady_slip";
     summary["params"] = Json::array();
     summary["param_symbols"] = Json::array();
     summary["param_units"] = Json::array();
@@ -175,6 +199,20 @@ int main(int argc, char** argv) {
             << (relErrors[k].empty() ? std::nan("") : relErrors[k][i]) << '\n';
     }
     csv.close();
+    if (vehicle == "quarter_car" && relaxation) {
+      // The seed's steady-slip tire for comparison (fd_central at the same accuracy).
+      QuarterCarParams qs = quarterCar;
+      qs.tire.relaxation_length_longitudinal_m = 0;
+      qs.tire.relaxation_length_lateral_m = 0;
+      SensitivityProblem ps = prob;
+      ps.model = std::make_shared<QuarterCarDesign>(qs);
+      const SensitivityResult r = makeSensitivityMethod("fd_central", set)->compute(ps);
+      summary["steady_slip_tire"] = {{"psi", r.psi}, {"dpsi_db", r.dpsi_db}, {"method", "fd_central"},
+                                     {"accuracy", ps.integrator.accuracy}, {"wall_time_s", r.wall_time_s}};
+      std::printf("  steady-slip tire (fd_central): psi = %.9g, d psi / d b =", r.psi);
+      for (double d : r.dpsi_db) std::printf(" %.6g", d);
+      std::printf("\n");
+    }
     study::writeJson(out + "/summary.json", summary);
 
     if (!vm.count("no-plots") && reference && results.size() > 1) {
@@ -201,7 +239,8 @@ int main(int argc, char** argv) {
       study::plot({p});
     }
 
-    std::printf("ch4_sensitivity: %s, %s, T = %g s, %s at accuracy %g\n", prob.model->describe().c_str(),
+    std::printf("ch4_sensitivity: %s%s, %s, T = %g s, %s at accuracy %g\n", prob.model->describe().c_str(),
+                vehicle != "quarter_car" ? "" : relaxation ? " (relaxation-length tire)" : " (steady-slip tire)",
                 prob.cost.describe().c_str(), prob.t_end_s, prob.integrator.method.c_str(), prob.integrator.accuracy);
     std::printf("  psi = %.9g\n", psi);
     std::printf("  %-34s", "d psi / d b");

@@ -43,14 +43,18 @@ constexpr double kInitialStep = 1e-3;
 /// Residual, constraint errors, q' and the output at the work state's (t, q, u)
 /// for fixed (u', lambda).
 struct Eval {
-  VectorXd R, a, qdot, udot;
+  VectorXd R, a, qdot, udot, zdot;  // zdot: of the auxiliary z only
   double y = 0;
 };
 
 class PointEvaluator {
  public:
-  PointEvaluator(const Scene& scene, SimTK::State& work, const Output* out, SimTK::Stage stage)
-      : scene_(scene), sys_(scene.getSystem()), matter_(scene.getMatter()), work_(work), out_(out), stage_(stage) {}
+  /// `zi`: indices of the auxiliary z (tire relaxation states) among the
+  /// state's z; their derivatives are realized at Stage::Dynamics.
+  PointEvaluator(const Scene& scene, SimTK::State& work, const Output* out, SimTK::Stage stage,
+                 const std::vector<int>& zi)
+      : scene_(scene), sys_(scene.getSystem()), matter_(scene.getMatter()), work_(work), out_(out), stage_(stage),
+        zi_(zi) {}
 
   Eval eval(const SimTK::Vector& udot, const SimTK::Vector& lambda) {
     sys_.realize(work_, stage_);
@@ -63,6 +67,8 @@ class PointEvaluator {
     e.a = toEigen(a_);
     e.qdot = toEigen(work_.getQDot());
     if (stage_ >= SimTK::Stage::Acceleration) e.udot = toEigen(work_.getUDot());
+    e.zdot.resize(zi_.size());
+    for (std::size_t j = 0; j < zi_.size(); ++j) e.zdot[j] = work_.getZDot()[zi_[j]];
     if (out_) e.y = out_->eval(work_);
     return e;
   }
@@ -75,6 +81,7 @@ class PointEvaluator {
   SimTK::State& work_;
   const Output* out_;
   SimTK::Stage stage_;
+  std::vector<int> zi_;
   SimTK::Vector R_, a_;
 };
 
@@ -86,9 +93,10 @@ struct PointJacobians : ResidualJacobians {
 };
 
 /// `state` must be realized to Acceleration (its u', lambda are the fixed values).
+/// Columns: q, u, then the auxiliary z listed in `zi`.
 PointJacobians evalJacobians(const Scene& scene, const SimTK::State& state, SimTK::State& work, const Output* out,
-                             SimTK::Stage stage, bool withForwardDynamics) {
-  const int nq = state.getNQ(), nu = state.getNU();
+                             SimTK::Stage stage, bool withForwardDynamics, const std::vector<int>& zi) {
+  const int nq = state.getNQ(), nu = state.getNU(), nw = static_cast<int>(zi.size()), n = nq + nu + nw;
   const SimTK::Vector& udot = state.getUDot();
   const SimTK::Vector& lambda = state.getMultipliers();
   work.setTime(state.getTime());
@@ -96,20 +104,22 @@ PointJacobians evalJacobians(const Scene& scene, const SimTK::State& state, SimT
   work.updU() = state.getU();
   if (state.getNZ()) work.updZ() = state.getZ();
   if (withForwardDynamics) stage = SimTK::Stage::Acceleration;
-  PointEvaluator ev(scene, work, out, stage);
+  PointEvaluator ev(scene, work, out, stage, zi);
   PointJacobians J;
   J.nominal = ev.eval(udot, lambda);
   const int m = static_cast<int>(J.nominal.a.size());
-  J.R_x.resize(nu, nq + nu);
-  J.a_x.resize(m, nq + nu);
-  J.qdot_x.resize(nq, nq + nu);
-  J.y_x.resize(nq + nu);
-  if (withForwardDynamics) J.udot_x.resize(nu, nq + nu);
+  J.R_x.resize(nu, n);
+  J.a_x.resize(m, n);
+  J.qdot_x.resize(nq, n);
+  J.zdot_x.resize(nw, n);
+  J.y_x.resize(n);
+  if (withForwardDynamics) J.udot_x.resize(nu, n);
   auto column = [&](int j, double h) {
     const Eval e = ev.eval(udot, lambda);
     J.R_x.col(j) = (e.R - J.nominal.R) / h;  // (4.30)-(4.32), (4.34)-(4.37)
     J.a_x.col(j) = (e.a - J.nominal.a) / h;  // (4.33), (4.38)
     J.qdot_x.col(j) = (e.qdot - J.nominal.qdot) / h;
+    J.zdot_x.col(j) = (e.zdot - J.nominal.zdot) / h;  // z_b' = f_z,x x_b + f_z,b
     J.y_x[j] = (e.y - J.nominal.y) / h;
     if (withForwardDynamics) J.udot_x.col(j) = (e.udot - J.nominal.udot) / h;
   };
@@ -124,6 +134,12 @@ PointJacobians evalJacobians(const Scene& scene, const SimTK::State& state, SimT
     work.updU()[j] = u + h;
     column(nq + j, h);
     work.updU()[j] = u;
+  }
+  for (int j = 0; j < nw; ++j) {
+    const double z = state.getZ()[zi[j]], h = kStateStep * std::max(std::abs(z), 1.0);
+    work.updZ()[zi[j]] = z + h;
+    column(nq + nu + j, h);
+    work.updZ()[zi[j]] = z;
   }
   SimTK::Matrix M, G;
   scene.getMatter().calcM(state, M);
@@ -146,13 +162,15 @@ Eigen::PartialPivLU<MatrixXd> factorKkt(const ResidualJacobians& J) {
 
 MatrixXd sensitivityMatrix(const ResidualJacobians& J, const Eigen::PartialPivLU<MatrixXd>& kkt) {
   const int nq = static_cast<int>(J.qdot_x.rows()), nu = static_cast<int>(J.M.rows());
-  const int m = static_cast<int>(J.G.rows()), n = nq + nu;
+  const int nw = static_cast<int>(J.zdot_x.rows());
+  const int m = static_cast<int>(J.G.rows()), n = nq + nu + nw;
   MatrixXd rhs(nu + m, n);
   rhs.topRows(nu) = -J.R_x;
   rhs.bottomRows(m) = -J.a_x;
   MatrixXd A(n, n);
   A.topRows(nq) = J.qdot_x;
-  A.bottomRows(nu) = kkt.solve(rhs).topRows(nu);  // (4.24), (4.27): u'_b = U' x_b + ...
+  A.middleRows(nq, nu) = kkt.solve(rhs).topRows(nu);  // (4.24), (4.27): u'_b = U' x_b + ...
+  A.bottomRows(nw) = J.zdot_x;
   return A;
 }
 
@@ -167,14 +185,20 @@ class MixedMethod : public SensitivityMethod {
 
 struct Sample {
   double t;
-  VectorXd q, u, qd, ud;
+  VectorXd q, u, z;  // z: all of the state's z (cost integral included)
 };
 
-void requireNoAuxiliaryStates(const SimTK::State& s, int costStates, const std::string& what) {
-  if (s.getNZ() != costStates)
-    throw Error("mixed: the " + what + " has " + std::to_string(s.getNZ() - costStates) +
-                " auxiliary state variable(s) (z) besides the cost integral (e.g. a relaxation-length tire); the "
-                "mixed method differentiates q and u only: use fd_forward, fd_central or reference");
+/// Index of the cost integral among the z of `s` (-1 if none): the z whose
+/// change moves the integral's value.
+int integralZIndex(const Scene& sc, IntegralHandle h, const SimTK::State& s) {
+  const double v0 = sc.getIntegral(h, s);
+  for (int j = 0; j < s.getNZ(); ++j) {
+    SimTK::State w = s;
+    w.updZ()[j] += 1;
+    if (sc.getIntegral(h, w) != v0) return j;
+  }
+  throw Error("mixed: the cost integral's state variable was not found among the " + std::to_string(s.getNZ()) +
+              " z of the scene");
 }
 
 SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
@@ -194,10 +218,18 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
   IntegralHandle psiHandle;
   if (integral) psiHandle = sc.addIntegralOfSquare(cost.output);
   SimTK::State s = toEulerAngles(sc, nominal->makeInitialState());
-  requireNoAuxiliaryStates(s, integral ? 1 : 0, p.model->describe() + " scene");
   const SimTK::MultibodySystem& sys = sc.getSystem();
   const SimTK::SimbodyMatterSubsystem& matter = sc.getMatter();
-  const int nq = s.getNQ(), nu = s.getNU(), n = nq + nu;
+  // Auxiliary first-order states (tire relaxation deflections) join q and u
+  // in x; the cost integral's z is left out (its sensitivity is the
+  // quadrature of (4.47) below).
+  const int zPsi = integral ? integralZIndex(sc, psiHandle, s) : -1;
+  std::vector<int> zi;
+  for (int j = 0; j < s.getNZ(); ++j)
+    if (j != zPsi) zi.push_back(j);
+  const int nq = s.getNQ(), nu = s.getNU(), nw = static_cast<int>(zi.size()), n = nq + nu + nw;
+  std::vector<int> ziPerturbed(nw);  // the perturbed models carry no cost integral
+  for (int j = 0; j < nw; ++j) ziPerturbed[j] = j;
   const double t0 = s.getTime(), T = p.t_end_s, tEnd = t0 + T;
   // Inputs may switch on at t0 (the sine road starts there): coefficients at
   // the first grid point are the right-hand limits.
@@ -208,8 +240,7 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
   double maxSample = -SimTK::Infinity;
   auto store = [&](const SimTK::State& st) {
     sys.realize(st, SimTK::Stage::Acceleration);
-    samples.push_back({st.getTime(), toEigen(st.getQ()), toEigen(st.getU()), toEigen(st.getQDot()),
-                       toEigen(st.getUDot())});
+    samples.push_back({st.getTime(), toEigen(st.getQ()), toEigen(st.getU()), toEigen(st.getZ())});
     if (cost.kind == CostKind::Maximum) maxSample = std::max(maxSample, out.eval(st));
   };
   {
@@ -251,8 +282,8 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
     SimTK::State w = ps.getDefaultState();
     ps.getMatter().setUseEulerAngles(w, true);
     ps.getSystem().realizeModel(w);
-    requireNoAuxiliaryStates(w, 0, p.model->describe() + " scene");
-    assert(w.getNQ() == nq && w.getNU() == nu);
+    if (w.getNQ() != nq || w.getNU() != nu || w.getNZ() != nw)
+      throw Error("mixed: perturbing " + params[i].name + " changed the state layout (nq, nu, nz)");
     pwork.push_back(w);
     // Initial state x(0; b) (e.g. a static equilibrium): central difference.
     const double h0 = kInitialStep * scale;
@@ -263,7 +294,9 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
       auto inst = p.model->build(bk);
       const SimTK::State sk = toEulerAngles(inst->getScene(), inst->makeInitialState());
       x[k].resize(n);
-      x[k] << toEigen(sk.getQ()), toEigen(sk.getU());
+      x[k].head(nq) = toEigen(sk.getQ());
+      x[k].segment(nq, nu) = toEigen(sk.getU());
+      for (int j = 0; j < nw; ++j) x[k][nq + nu + j] = sk.getZ()[j];
     }
     X0.col(c) = (x[0] - x[1]) / (2 * h0);
     if (std::getenv("VDYN_DEBUG_MIXED")) std::fprintf(stderr, "X0 col %d: %g %g\n", c, X0(0, c), X0(n - 1, c));
@@ -289,8 +322,9 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
     nomWork.setTime(t);
     for (int i = 0; i < nq; ++i) nomWork.updQ()[i] = samples[k].q[i];
     for (int i = 0; i < nu; ++i) nomWork.updU()[i] = samples[k].u[i];
+    for (int i = 0; i < nomWork.getNZ(); ++i) nomWork.updZ()[i] = samples[k].z[i];
     sys.realize(nomWork, SimTK::Stage::Acceleration);
-    const PointJacobians J = evalJacobians(sc, nomWork, colWork, &out, stage, false);
+    const PointJacobians J = evalJacobians(sc, nomWork, colWork, &out, stage, false, zi);
     res.residual_evaluations += J.evaluations;
     const auto kkt = factorKkt(J);
     Point P;
@@ -305,12 +339,14 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
       w.setTime(t);
       w.updQ() = nomWork.getQ();
       w.updU() = nomWork.getU();
-      PointEvaluator ev(perturbed[c]->getScene(), w, &perturbed[c]->getScene().getOutput(cost.output), stage);
+      for (int j = 0; j < nw; ++j) w.updZ()[j] = nomWork.getZ()[zi[j]];
+      PointEvaluator ev(perturbed[c]->getScene(), w, &perturbed[c]->getScene().getOutput(cost.output), stage,
+                        ziPerturbed);
       const Eval e = ev.eval(nomWork.getUDot(), nomWork.getMultipliers());
       ++res.residual_evaluations;
       VectorXd rhs(nu + m);
       rhs << -(e.R - J.nominal.R) / delta[c], -(e.a - J.nominal.a) / delta[c];  // R_b, a_b (4.44)
-      P.B.col(c) << (e.qdot - J.nominal.qdot) / delta[c], kkt.solve(rhs).head(nu);
+      P.B.col(c) << (e.qdot - J.nominal.qdot) / delta[c], kkt.solve(rhs).head(nu), (e.zdot - J.nominal.zdot) / delta[c];
       P.y_b[c] = (e.y - J.nominal.y) / delta[c];
     }
     return points.emplace(k, std::move(P)).first->second;
@@ -584,7 +620,9 @@ SimTK::State toEulerAngles(const Scene& scene, const SimTK::State& state) {
 ResidualJacobians calcResidualJacobians(const Scene& scene, const SimTK::State& state, SimTK::State& work,
                                         bool withForwardDynamics) {
   scene.getSystem().realize(state, SimTK::Stage::Acceleration);
-  return evalJacobians(scene, state, work, nullptr, SimTK::Stage::Dynamics, withForwardDynamics);
+  std::vector<int> zi(state.getNZ());
+  for (int j = 0; j < state.getNZ(); ++j) zi[j] = j;
+  return evalJacobians(scene, state, work, nullptr, SimTK::Stage::Dynamics, withForwardDynamics, zi);
 }
 
 MatrixXd calcSensitivityMatrix(const ResidualJacobians& J) { return sensitivityMatrix(J, factorKkt(J)); }

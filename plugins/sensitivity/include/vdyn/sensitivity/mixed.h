@@ -48,10 +48,13 @@ namespace vdyn {
 
 /// Finite-difference derivatives of the equations of motion at one state.
 struct ResidualJacobians {
-  Eigen::MatrixXd R_x;    ///< d R / d (q, u) at fixed u', lambda: nu x (nq + nu)
-  Eigen::MatrixXd a_x;    ///< d a / d (q, u) at fixed u': m x (nq + nu)
-  Eigen::MatrixXd qdot_x; ///< d (N u) / d (q, u): nq x (nq + nu)
-  Eigen::MatrixXd udot_x; ///< forward dynamics d u' / d (q, u) (only if requested): nu x (nq + nu)
+  // Columns x = (q, u, z): z are the auxiliary first-order states (tire
+  // relaxation deflections), whose z' Simbody realizes at Stage::Dynamics.
+  Eigen::MatrixXd R_x;    ///< d R / d x at fixed u', lambda: nu x (nq + nu + nz)
+  Eigen::MatrixXd a_x;    ///< d a / d x at fixed u': m x (nq + nu + nz)
+  Eigen::MatrixXd qdot_x; ///< d (N u) / d x: nq x (nq + nu + nz)
+  Eigen::MatrixXd zdot_x; ///< d z' / d x: nz x (nq + nu + nz)
+  Eigen::MatrixXd udot_x; ///< forward dynamics d u' / d x (only if requested): nu x (nq + nu + nz)
   Eigen::MatrixXd M, G;   ///< mass matrix nu x nu, constraint Jacobian m x nu
   int evaluations = 0;    ///< realizations used
 };
