@@ -1,5 +1,7 @@
 #include "vdyn/core/equilibrium.h"
 
+#include "vdyn/core/euler_state.h"
+
 #include <algorithm>
 #include <cstdio>
 #include <cstdlib>
@@ -14,11 +16,8 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
   const SimTK::MultibodySystem& system = scene.getSystem();
   const SimTK::SimbodyMatterSubsystem& matter = scene.getMatter();
   system.realize(state, SimTK::Stage::Instance);
-  // The same configuration with Euler angles, so nq == nu for every mobilizer
-  // (Simbody converts into an allocated state of the same system).
-  SimTK::State se = state;
-  if (!matter.getUseEulerAngles(state)) matter.convertToEulerAngles(state, se);
-  se.updZ() = state.getZ();  // Simbody 3.7's conversion resets z (u are zeroed below)
+  // The same configuration with Euler angles, so nq == nu for every mobilizer.
+  SimTK::State se = toEulerAngles(scene, state);
   system.realize(se, SimTK::Stage::Instance);
   se.updU() = 0;
   // With Euler angles there are no quaternion-normalization rows in qerr.
@@ -113,9 +112,8 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
   }
   res.multipliers = lambda;
   res.force_residual_all = residualForce;
-  SimTK::State out = se;
-  if (!matter.getUseEulerAngles(state)) matter.convertToQuaternions(se, out);
-  out.updZ() = se.getZ();
+  const bool wasEuler = matter.getUseEulerAngles(state);
+  SimTK::State out = wasEuler ? se : toQuaternions(scene, se);
   out.updU() = 0;
   state = out;
   system.realize(state, SimTK::Stage::Position);

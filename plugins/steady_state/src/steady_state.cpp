@@ -1,5 +1,7 @@
 #include "vdyn/steady_state/steady_state.h"
 
+#include "vdyn/core/euler_state.h"
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,43 +15,12 @@ using SimTK::Vec3;
 namespace {
 double maxAbs(const Eigen::VectorXd& v) { return v.size() ? v.lpNorm<Eigen::Infinity>() : 0.0; }
 bool contains(const std::vector<int>& v, int i) { return std::find(v.begin(), v.end(), i) != v.end(); }
-/// Copies `in` (realized to Instance here) into Euler-angle (or quaternion) form.
-SimTK::State toEulerAngles(const SimTK::MultibodySystem& system, const SimTK::SimbodyMatterSubsystem& matter,
-                           const SimTK::State& in) {
-  SimTK::State s = in;
-  system.realize(s, SimTK::Stage::Instance);
-  if (matter.getUseEulerAngles(s)) return s;
-  SimTK::State out = s;  // Simbody converts into an allocated state of the same system
-  matter.convertToEulerAngles(s, out);
-  // Simbody 3.7 re-realizes the output's Model stage, which resets u and z:
-  // copy them (and the time) over.
-  out.setTime(s.getTime());
-  out.updU() = s.getU();
-  out.updZ() = s.getZ();
-  system.realize(out, SimTK::Stage::Instance);
-  return out;
-}
-SimTK::State toQuaternions(const SimTK::MultibodySystem& system, const SimTK::SimbodyMatterSubsystem& matter,
-                           const SimTK::State& in) {
-  SimTK::State s = in;
-  system.realize(s, SimTK::Stage::Instance);
-  if (!matter.getUseEulerAngles(s)) return s;
-  SimTK::State out = s;
-  matter.convertToQuaternions(s, out);
-  // Simbody 3.7 re-realizes the output's Model stage, which resets u and z:
-  // copy them (and the time) over.
-  out.setTime(s.getTime());
-  out.updU() = s.getU();
-  out.updZ() = s.getZ();
-  system.realize(out, SimTK::Stage::Instance);
-  return out;
-}
 }  // namespace
 
 SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::string& chassisBody,
                                             const std::vector<std::string>& wheelBodies, double time_s) {
   const SimTK::MobilizedBody& chassis = scene.getBody(chassisBody);
-  const SimTK::State se = toEulerAngles(scene.getSystem(), scene.getMatter(), scene.getDefaultState());
+  const SimTK::State se = toEulerAngles(scene, scene.getDefaultState());
   if (chassis.getNumQ(se) != 6 || chassis.getNumU(se) != 6)
     throw Error("steady turning: chassis '" + chassisBody + "' must be on a free mobilizer (6 q and 6 u), has " +
                 std::to_string(chassis.getNumU(se)) + " u");
@@ -83,7 +54,7 @@ SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::strin
 SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem problem, SteadyStateOptions options)
     : scene_(scene), problem_(std::move(problem)), opt_(options) {
   const SimTK::MultibodySystem& system = scene_.getSystem();
-  se_ = toEulerAngles(system, scene_.getMatter(), scene_.getDefaultState());
+  se_ = toEulerAngles(scene_, scene_.getDefaultState());
   // In Euler-angle form every mobilizer has as many q as u; Simbody keeps the
   // q vector at its quaternion size, so the coordinates in use are listed.
   const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
@@ -248,7 +219,7 @@ std::string SteadyStateSolver::describeEquation(int row) const {
 }
 
 SteadyStateResult SteadyStateSolver::solve(const SimTK::State& guess) {
-  const SimTK::State se = toEulerAngles(scene_.getSystem(), scene_.getMatter(), guess);
+  const SimTK::State se = toEulerAngles(scene_, guess);
   haveJacobian_ = false;
   return solveFrom(se, SimTK::Vector(m_, 0.0));
 }
@@ -369,7 +340,7 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
   res.multipliers.resize(m_);
   for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nu_ + i];
   res.euler_state = se_;
-  res.state = toQuaternions(system, scene_.getMatter(), se_);
+  res.state = toQuaternions(scene_, se_);
   system.realize(res.state, SimTK::Stage::Velocity);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
