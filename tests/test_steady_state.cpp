@@ -13,6 +13,7 @@
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/adjustable_hold.h"
 #include "vdyn/vehicles/bicycle.h"
+#include "vdyn/vehicles/fourws.h"
 
 using namespace vdyn;
 using vdyn::test::errorOf;
@@ -185,4 +186,38 @@ TEST(SteadyState, ProblemErrorsAreNamed) {
   p.effective_u.pop_back();
   EXPECT_NE(errorOf([&] { SteadyStateSolver(c.bike->getScene(), p); }).find("must equal the number of mobilities"),
             std::string::npos);
+}
+
+// The relaxation-length tire changes transients only: the 4WS steady turn with
+// it equals the steady-slip tire's, and its patch deflections sit at sigma x
+// the steady slips (zdot = 0 is one of the solved equations).
+TEST(SteadyState, RelaxationTireLeavesTheSteadyTurnUnchanged) {
+  auto solveWith = [](const std::string& file, SteadyStateResult& out) {
+    auto car = std::make_unique<FourWsVehicle>(FourWsParams::fromFile(file));
+    car->addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(4.0 * kDeg));
+    car->addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(1.0 * kDeg));
+    car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
+    const Scene& sc = car->getScene();
+    SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
+    out = solver.solve(car->makeInitialState(10.0));
+    return car;
+  };
+  SteadyStateResult plain, relaxed;
+  const auto carPlain = solveWith("appendix_a.json", plain);
+  const auto carRelaxed = solveWith("appendix_a_relaxation.json", relaxed);
+  EXPECT_EQ(plain.state.getNZ(), 0);
+  ASSERT_EQ(relaxed.state.getNZ(), 8);  // two patch deflections per tire
+  for (const char* out : {"chassis.yaw_rate_rad_s", "chassis.z_m", "chassis.roll_rad", "chassis.side_slip_rad",
+                          "rf.spin_rad_s", "lr.spin_rad_s", "speed_hold.force_N"}) {
+    const double a = carPlain->getScene().evalOutput(out, plain.state);
+    const double b = carRelaxed->getScene().evalOutput(out, relaxed.state);
+    // The hold force is a multiplier: solved to the force tolerance (1e-6 N).
+    const double tol = std::string(out) == "speed_hold.force_N" ? 1e-6 : 1e-9 * std::max(1.0, std::abs(a));
+    EXPECT_NEAR(b, a, tol) << out;
+  }
+  // Lateral deflection of the RF tire = sigma_y x tan(alpha) at the steady state.
+  const TireContact c = carRelaxed->tire(RF).calcContact(relaxed.state);
+  const double tanAlpha = c.kinematics.vy_m_s / std::abs(c.kinematics.vx_m_s);
+  EXPECT_NEAR(c.kinematics.tan_alpha, tanAlpha, 1e-9);
+  EXPECT_GT(std::abs(tanAlpha), 1e-3);  // the tire is slipping: the check is not trivial
 }
