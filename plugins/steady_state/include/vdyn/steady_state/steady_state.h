@@ -87,7 +87,10 @@ class SteadyStateError : public Error {
 };
 
 struct SteadyStateResult {
-  SimTK::State state;              ///< the steady state (quaternion form), realized to Velocity
+  /// The steady state (quaternion form), realized to Velocity. A copy of a
+  /// State loses its realized stages: realize a copy (or use
+  /// Scene::evalOutput, which does) before reading kinematics from it.
+  SimTK::State state;
   SimTK::State euler_state;        ///< the same in Euler-angle form (restart point)
   int iterations = 0;              ///< Newton iterations
   int jacobians = 0;               ///< finite-difference Jacobians taken
