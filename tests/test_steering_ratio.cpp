@@ -258,14 +258,18 @@ TEST(SteeringRatio, GimTireBranchEndsWithAdmissiblePointsOnly) {
     if (q.status == OptimalRatioStatus::NoSteadyState) continue;
     ++reached;
     EXPECT_TRUE(q.stable);
-    if (q.status == OptimalRatioStatus::ZeroSideSlip) EXPECT_LT(std::abs(slip(q.result.state)), 1e-8);
-    else EXPECT_FALSE(q.failure.empty());
+    if (q.status == OptimalRatioStatus::ZeroSideSlip) {
+      EXPECT_LT(std::abs(slip(q.result.state)), 1e-8);
+    } else {
+      EXPECT_FALSE(q.failure.empty());
+    }
   }
   EXPECT_GE(reached, 2);
   // The requested 1.5 and 2 deg are reached (by halving the first step from 0).
   for (const auto& q : pts)
-    if (std::abs(q.front_rad - 1.5 * kDeg) < 1e-12 || std::abs(q.front_rad - 2.0 * kDeg) < 1e-12)
+    if (std::abs(q.front_rad - 1.5 * kDeg) < 1e-12 || std::abs(q.front_rad - 2.0 * kDeg) < 1e-12) {
       EXPECT_EQ(q.status, OptimalRatioStatus::ZeroSideSlip) << q.front_rad / kDeg << ": " << q.failure;
+    }
   EXPECT_EQ(pts.back().status, OptimalRatioStatus::NoSteadyState);  // 3 deg is beyond the branch at 25 m/s
   // In phase at 25 m/s, and growing with the front angle (tire saturation).
   EXPECT_GT(pts[0].kr, 0.4);

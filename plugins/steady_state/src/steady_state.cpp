@@ -53,7 +53,6 @@ SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::strin
 // ---------------------------------------------------------------------------
 SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem problem, SteadyStateOptions options)
     : scene_(scene), problem_(std::move(problem)), opt_(options) {
-  const SimTK::MultibodySystem& system = scene_.getSystem();
   se_ = toEulerAngles(scene_, scene_.getDefaultState());
   // In Euler-angle form every mobilizer has as many q as u; Simbody keeps the
   // q vector at its quaternion size, so the coordinates in use are listed.
