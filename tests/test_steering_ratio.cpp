@@ -254,7 +254,9 @@ TEST(SteeringRatio, GimTireBranchEndsWithAdmissiblePointsOnly) {
     const auto& q = pts[i];
     std::printf("front %.4f deg: %s Kr %.5f beta %.3e stable %d\n", q.front_rad / kDeg, toString(q.status), q.kr,
                 q.side_slip_rad, q.stable);
-    if (i > 0) EXPECT_GT(q.front_rad, pts[i - 1].front_rad);
+    if (i > 0) {
+      EXPECT_GT(q.front_rad, pts[i - 1].front_rad);
+    }
     if (q.status == OptimalRatioStatus::NoSteadyState) continue;
     ++reached;
     EXPECT_TRUE(q.stable);
