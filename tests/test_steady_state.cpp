@@ -11,7 +11,7 @@
 #include "vdyn/core/simulation.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
-#include "vdyn/steering/adjustable_hold.h"
+#include "vdyn/steering/steering.h"
 #include "vdyn/vehicles/bicycle.h"
 #include "vdyn/vehicles/fourws.h"
 
@@ -23,7 +23,7 @@ const double kDeg = SimTK::Pi / 180;
 
 struct BikeCase {
   std::unique_ptr<Bicycle> bike;
-  std::shared_ptr<AdjustableHoldCommand> steer;
+  std::shared_ptr<HoldCommand> steer;
   const SpeedHoldPlugin* speed = nullptr;
   std::unique_ptr<SteadyStateSolver> solver;
   SimTK::State start;
@@ -34,7 +34,7 @@ BikeCase makeBike(const std::string& tire, double U, double delta) {
   p.tire_plugin = tire;
   BikeCase c;
   c.bike = std::make_unique<Bicycle>(p);
-  c.steer = std::make_shared<AdjustableHoldCommand>(0.0);
+  c.steer = std::make_shared<HoldCommand>(0.0);
   c.bike->addFrontSteering("front_steer", c.steer);
   c.speed = &static_cast<const SpeedHoldPlugin&>(
       c.bike->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U)));

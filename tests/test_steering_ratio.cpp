@@ -12,7 +12,7 @@
 #include "test_util.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
-#include "vdyn/steering/adjustable_hold.h"
+#include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/steering_ratio.h"
 #include "vdyn/vehicles/fourws.h"
 
@@ -114,8 +114,8 @@ namespace {
 /// The App. A vehicle with linear tires, front and rear held, speed held.
 struct LinearFourWs {
   std::unique_ptr<FourWsVehicle> car;
-  std::shared_ptr<AdjustableHoldCommand> front = std::make_shared<AdjustableHoldCommand>(0.0);
-  std::shared_ptr<AdjustableHoldCommand> rear = std::make_shared<AdjustableHoldCommand>(0.0);
+  std::shared_ptr<HoldCommand> front = std::make_shared<HoldCommand>(0.0);
+  std::shared_ptr<HoldCommand> rear = std::make_shared<HoldCommand>(0.0);
   std::unique_ptr<SteadyStateSolver> solver;
   SteadyStateResult straight;
   LinearBicycleParams lin;  // the vehicle's own linear bicycle
@@ -230,7 +230,7 @@ TEST(SteeringRatio, GimTireBranchEndsWithAdmissiblePointsOnly) {
   const double U = 25.0;
   FourWsParams p = FourWsParams::fromFile("appendix_a.json");
   FourWsVehicle car(p);
-  auto front = std::make_shared<AdjustableHoldCommand>(0.0), rear = std::make_shared<AdjustableHoldCommand>(0.0);
+  auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
   car.addAxleSteering("front_steer", true, front);
   car.addAxleSteering("rear_steer", false, rear);
   const auto& hold = static_cast<const SpeedHoldPlugin&>(

@@ -25,7 +25,7 @@
 #include "study.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
-#include "vdyn/steering/adjustable_hold.h"
+#include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/steering_ratio.h"
 #include "vdyn/vehicles/fourws.h"
 
@@ -194,7 +194,7 @@ int main(int argc, char** argv) {
         try {
           const double U = speeds[i];
           std::unique_ptr<FourWsVehicle> car;
-          auto front = std::make_shared<AdjustableHoldCommand>(0.0), rear = std::make_shared<AdjustableHoldCommand>(0.0);
+          auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
           const SpeedHoldPlugin* hold = nullptr;
           {
             // Building goes through the shared plugin registry: one at a time.

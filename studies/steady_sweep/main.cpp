@@ -12,7 +12,7 @@
 #include "study.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
-#include "vdyn/steering/adjustable_hold.h"
+#include "vdyn/steering/steering.h"
 #include "vdyn/vehicles/fourws.h"
 
 using namespace vdyn;
@@ -52,7 +52,7 @@ int main(int argc, char** argv) {
     const std::string out = study::outputDir(vm, "steady_sweep");
 
     FourWsVehicle car(FourWsParams::fromFile(vm["data"].as<std::string>()));
-    auto front = std::make_shared<AdjustableHoldCommand>(0.0), rear = std::make_shared<AdjustableHoldCommand>(0.0);
+    auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
     car.addAxleSteering("front_steer", true, front);
     car.addAxleSteering("rear_steer", false, rear);
     const auto& hold = static_cast<const SpeedHoldPlugin&>(

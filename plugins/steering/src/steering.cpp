@@ -13,7 +13,9 @@ SteerCommandValue SteeringCommand::calcAt(double t) const {
   return v;
 }
 
-HoldCommand::HoldCommand(double a) : angle_(requireInRange(a, -1.2, 1.2, "steering hold angle_rad")) {}
+HoldCommand::HoldCommand(double a) { setAngle(a); }
+
+void HoldCommand::setAngle(double a) { angle_ = requireInRange(a, -1.2, 1.2, "steering hold angle_rad"); }
 
 SmoothStepCommand::SmoothStepCommand(double d0, double D, double t0, double T)
     : d0_(requireInRange(d0, -1.2, 1.2, "steering initial_rad")),

@@ -52,10 +52,16 @@ class SteeringCommand {
   virtual SteerCommandValue DoCalc(double t_s) const = 0;
 };
 
-/// Holds a constant angle.
+/// Holds a constant angle, rad (+ left, |angle| <= 1.2). setAngle() changes it
+/// between runs or steady-state solves without rebuilding the scene
+/// (continuation in the steering angle). The angle is a model parameter, not a
+/// state variable: states realized before must be re-realized from
+/// Stage::Position (SteadyStateSolver does that itself).
 class HoldCommand : public SteeringCommand {
  public:
   explicit HoldCommand(double angle_rad);
+  void setAngle(double angle_rad);
+  double getAngle() const { return angle_; }
 
  protected:
   SteerCommandValue DoCalc(double) const override { return {angle_, 0, 0}; }

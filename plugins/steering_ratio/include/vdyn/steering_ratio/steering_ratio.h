@@ -120,7 +120,7 @@ struct OptimalRatioPoint {
 };
 
 /// Applies a front and rear steering angle (rad, + left) to the model, e.g.
-/// two AdjustableHoldCommand's setAngle(); the state may be changed too.
+/// two HoldCommand's setAngle(); the state may be changed too.
 using SetSteering = std::function<void(SimTK::State&, double front_rad, double rear_rad)>;
 /// The side slip beta (rad) of a steady state (realized to Velocity), e.g. the
 /// scene output "chassis.side_slip_rad".
