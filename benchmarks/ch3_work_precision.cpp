@@ -10,6 +10,7 @@
 #include <fstream>
 
 #include "bench_util.h"
+#include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/speed/speed_hold.h"
@@ -24,14 +25,12 @@ struct Run {
 };
 
 Run runCh3(const ParamReader& data, const std::string& method, double accuracy, double tEnd) {
-  FourWsVehicle car(FourWsParams::fromFile(data.string("vehicle_data")));
-  const double t0 = data.number("steer_start_time_s"), T = data.number("steer_duration_s");
-  car.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, data.number("front_angle_rad"), t0, T));
-  car.addAxleSteering("rear_steer", false, std::make_shared<SmoothStepCommand>(0, data.number("rear_angle_rad"), t0, T));
-  const double U0 = data.number("speed_m_s");
-  car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
+  const study::Ch3Case ch3 = study::Ch3Case::fromData(data);
+  const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
+  const FourWsVehicle& car = *carPtr;
+  const double U0 = ch3.speed_m_s;
   SimTK::State s = car.makeInitialState(U0);
-  SimulationSettings sim;
+  SimulationSettings sim = ch3.sim;  // the data file's constraint tolerance; method, accuracy and time swept
   sim.t_end_s = tEnd;
   sim.report_interval_s = 0.05;
   sim.integrator.method = method;

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/speed/speed_hold.h"
@@ -39,43 +40,28 @@ int main(int argc, char** argv) {
   return study::run("ch3_steady_state", [&] {
     namespace po = study::po;
     po::options_description opts("Options");
-    opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file")(
-        "speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
-        "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
-        "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
-        "t-end-s", po::value<double>(), "simulated time of the transient, s (default: the data file's, 40)")(
-        "integrator", po::value<std::string>(), "transient integrator")(
-        "accuracy", po::value<double>(), "transient integrator relative accuracy");
+    opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file");
+    study::Ch3Case::addOptions(opts, "simulated time of the transient, s (default 40)");
     const auto vm = study::parse("ch3_steady_state", "chapter 3 steady state against the long transient", argc, argv,
                                  opts);
-    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    study::Ch3Case ch3 = study::Ch3Case::fromData(ParamReader::fromFile(vm["data"].as<std::string>()), &vm);
+    // Long enough to settle (the data file's 20 s is the transient study's).
+    if (!vm.count("t-end-s")) ch3.sim.t_end_s = 40.0;
+    ch3.sim.report_interval_s = 0;  // final state only
     const double deg = SimTK::Pi / 180;
-    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
-    const double front = vm.count("front-deg") ? vm["front-deg"].as<double>() * deg : data.number("front_angle_rad");
-    const double rear = vm.count("rear-deg") ? vm["rear-deg"].as<double>() * deg : data.number("rear_angle_rad");
-    const double t0 = data.number("steer_start_time_s"), T = data.number("steer_duration_s");
-    const ParamReader simData = data.child("simulation");
-    SimulationSettings sim;
-    sim.t_end_s = vm.count("t-end-s") ? vm["t-end-s"].as<double>() : data.numberOr("steady_comparison_t_end_s", 40.0);
-    sim.report_interval_s = 0;  // final state only
-    sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
-    if (vm.count("integrator")) sim.integrator.method = vm["integrator"].as<std::string>();
-    if (vm.count("accuracy")) sim.integrator.accuracy = vm["accuracy"].as<double>();
-    requirePositive(U0, "--speed-m-s");
-    requirePositive(sim.t_end_s, "--t-end-s");
+    const double U0 = ch3.speed_m_s, front = ch3.front_rad, rear = ch3.rear_rad;
+    const SimulationSettings sim = ch3.sim;
     const std::string out = study::outputDir(vm, "ch3_steady_state");
 
-    FourWsVehicle car(FourWsParams::fromFile(data.string("vehicle_data")));
-    car.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, front, t0, T));
-    car.addAxleSteering("rear_steer", false, std::make_shared<SmoothStepCommand>(0, rear, t0, T));
-    car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
+    const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
+    const FourWsVehicle& car = *carPtr;
     const Scene& sc = car.getScene();
     const SimTK::State initial = car.makeInitialState(U0);
 
     // Steady state from the transient's initial conditions; the steering
-    // commands are evaluated after they settled (t0 + T).
+    // commands are evaluated after they settled (Ch3Case::settledTime).
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"},
-                                                          t0 + T));
+                                                          ch3.settledTime()));
     const SteadyStateResult ss = solver.solve(initial);
     const auto ts = std::chrono::steady_clock::now();
     const StabilityResult stab = solver.calcStability(ss);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/speed/speed_hold.h"
@@ -17,35 +18,18 @@ int main(int argc, char** argv) {
     namespace po = study::po;
     po::options_description opts("Options");
     opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file")(
-        "speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
-        "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
-        "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
-        "t-end-s", po::value<double>(), "simulated time, s (default 20)")(
-        "integrator", po::value<std::string>(), "rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
-        "accuracy", po::value<double>(), "integrator relative accuracy")("no-plots", "skip the PNG plots");
+        "no-plots", "skip the PNG plots");
+    study::Ch3Case::addOptions(opts, "simulated time, s (default: the data file's, 20)");
     const auto vm = study::parse("ch3_transient", "chapter 3 transient of the 4WS vehicle (steer step at constant speed)",
                                  argc, argv, opts);
-    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    const study::Ch3Case ch3 = study::Ch3Case::fromData(ParamReader::fromFile(vm["data"].as<std::string>()), &vm);
     const double deg = SimTK::Pi / 180;
-    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
-    const double front = vm.count("front-deg") ? vm["front-deg"].as<double>() * deg : data.number("front_angle_rad");
-    const double rear = vm.count("rear-deg") ? vm["rear-deg"].as<double>() * deg : data.number("rear_angle_rad");
-    const double t0 = data.number("steer_start_time_s"), T = data.number("steer_duration_s");
-    SimulationSettings sim;
-    const ParamReader simData = data.child("simulation");
-    sim.t_end_s = vm.count("t-end-s") ? vm["t-end-s"].as<double>() : simData.number("t_end_s");
-    sim.report_interval_s = simData.number("report_interval_s");
-    sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
-    if (vm.count("integrator")) sim.integrator.method = vm["integrator"].as<std::string>();
-    if (vm.count("accuracy")) sim.integrator.accuracy = vm["accuracy"].as<double>();
-    requirePositive(U0, "--speed-m-s");
-    requirePositive(sim.t_end_s, "--t-end-s");
+    const double U0 = ch3.speed_m_s, front = ch3.front_rad, rear = ch3.rear_rad;
+    const SimulationSettings sim = ch3.sim;
     const std::string out = study::outputDir(vm, "ch3_transient");
 
-    FourWsVehicle car(FourWsParams::fromFile(data.string("vehicle_data")));
-    car.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, front, t0, T));
-    car.addAxleSteering("rear_steer", false, std::make_shared<SmoothStepCommand>(0, rear, t0, T));
-    car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
+    const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
+    FourWsVehicle& car = *carPtr;
     AssemblyReport assembly;
     SimTK::State s = car.makeInitialState(U0, &assembly);
     const int dof = car.degreesOfFreedom(s);

@@ -1,0 +1,73 @@
+#pragma once
+// The seed's chapter 3 manoeuvre (section 3.3), one definition for the
+// programs that run it (ch3_transient, ch3_steady_state,
+// benchmarks/ch3_work_precision): the App. A 4WS vehicle at a constant speed
+// (3.18), front and rear wheels steered by a smooth step (7.4), read from the
+// manoeuvre data file (ch3_transient.json) with command-line overrides.
+// Header-only: include it from a target that links vdyn_vehicles.
+#include <memory>
+#include <string>
+
+#include "study.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/vehicles/fourws.h"
+
+namespace vdyn::study {
+
+struct Ch3Case {
+  std::string vehicle_data;          ///< vehicle data file
+  double speed_m_s = 10;             ///< U0, m/s
+  double front_rad = 0, rear_rad = 0;  ///< final steering angles, rad (+ left)
+  double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
+  SimulationSettings sim;            ///< the data file's "simulation"
+
+  /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
+  /// --integrator, --accuracy.
+  static void addOptions(po::options_description& opts, const std::string& tEndHelp) {
+    opts.add_options()("speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
+        "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
+        "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
+        "t-end-s", po::value<double>(), tEndHelp.c_str())(
+        "integrator", po::value<std::string>(), "rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
+        "accuracy", po::value<double>(), "integrator relative accuracy");
+  }
+
+  /// The data file's case; options in `vm` (if given) override it.
+  static Ch3Case fromData(const ParamReader& data, const po::variables_map* vm = nullptr) {
+    const double deg = SimTK::Pi / 180;
+    auto has = [&](const char* k) { return vm && vm->count(k); };
+    Ch3Case c;
+    c.vehicle_data = data.string("vehicle_data");
+    c.speed_m_s = has("speed-m-s") ? (*vm)["speed-m-s"].as<double>() : data.number("speed_m_s");
+    c.front_rad = has("front-deg") ? (*vm)["front-deg"].as<double>() * deg : data.number("front_angle_rad");
+    c.rear_rad = has("rear-deg") ? (*vm)["rear-deg"].as<double>() * deg : data.number("rear_angle_rad");
+    c.steer_start_s = data.number("steer_start_time_s");
+    c.steer_duration_s = data.number("steer_duration_s");
+    const ParamReader simData = data.child("simulation");
+    c.sim.t_end_s = has("t-end-s") ? (*vm)["t-end-s"].as<double>() : simData.number("t_end_s");
+    c.sim.report_interval_s = simData.number("report_interval_s");
+    c.sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
+    if (has("integrator")) c.sim.integrator.method = (*vm)["integrator"].as<std::string>();
+    if (has("accuracy")) c.sim.integrator.accuracy = (*vm)["accuracy"].as<double>();
+    requirePositive(c.speed_m_s, "--speed-m-s");
+    requirePositive(c.sim.t_end_s, "--t-end-s");
+    return c;
+  }
+
+  /// When every command has settled (the steady state's evaluation time), s.
+  double settledTime() const { return steer_start_s + steer_duration_s; }
+
+  /// The vehicle with its steering ("front_steer", "rear_steer") and speed hold ("speed_hold").
+  std::unique_ptr<FourWsVehicle> buildVehicle() const {
+    auto car = std::make_unique<FourWsVehicle>(FourWsParams::fromFile(vehicle_data));
+    car->addAxleSteering("front_steer", true,
+                         std::make_shared<SmoothStepCommand>(0, front_rad, steer_start_s, steer_duration_s));
+    car->addAxleSteering("rear_steer", false,
+                         std::make_shared<SmoothStepCommand>(0, rear_rad, steer_start_s, steer_duration_s));
+    car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", speed_m_s));
+    return car;
+  }
+};
+
+}  // namespace vdyn::study
