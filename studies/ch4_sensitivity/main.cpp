@@ -52,8 +52,6 @@ int main(int argc, char** argv) {
         "vehicle", po::value<std::string>()->default_value("quarter_car"), "quarter_car or fourws")(
         "method", po::value<std::string>()->default_value("all"),
         "comma list of fd_forward, fd_central, mixed, reference, or all (errors need the reference)")(
-        "integrator", po::value<std::string>(), "rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
-        "accuracy", po::value<double>(), "integrator relative accuracy of fd_forward, fd_central, mixed")(
         "tolerance", po::value<double>(), "mixed: relative tolerance of the sensitivity integration error")(
         "reference-accuracy", po::value<double>(), "reference: integrator relative accuracy")(
         "perturbation", po::value<double>(), "finite differences: relative perturbation (default: rule from the accuracy)")(
@@ -63,6 +61,7 @@ int main(int argc, char** argv) {
         "quarter car: on (relaxation-length tire, lengths from the data file's tire_relaxation) or off (the "
         "seed's steady-slip tire); default: the data file's tire_relaxation.enabled")(
         "no-plots", "skip the PNG plots");
+    study::addIntegratorOptions(opts);
     const auto vm = study::parse("ch4_sensitivity", "design sensitivity d psi / d b by finite differences, the mixed "
                                  "method and a reference", argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
@@ -111,8 +110,7 @@ int main(int argc, char** argv) {
       throw Error("--vehicle must be quarter_car or fourws, got '" + vehicle + "'");
     }
     prob.integrator = IntegratorSettings::fromParams(data.child("integrator"));
-    if (vm.count("integrator")) prob.integrator.method = vm["integrator"].as<std::string>();
-    if (vm.count("accuracy")) prob.integrator.accuracy = vm["accuracy"].as<double>();
+    study::applyIntegratorOptions(vm, prob.integrator);
     if (vm.count("params")) prob.parameters = splitList(vm["params"].as<std::string>());
     if (vm.count("t-end-s")) prob.t_end_s = requirePositive(vm["t-end-s"].as<double>(), "--t-end-s");
     prob.validate();

@@ -64,9 +64,8 @@ int main(int argc, char** argv) {
     po::options_description opts("Options");
     opts.add_options()("data", po::value<std::string>()->default_value("ch7_open_loop.json"), "manoeuvre data file")(
         "speed-m-s", po::value<double>(), "constant forward speed, m/s (seed: 10)")(
-        "integrator", po::value<std::string>(), "integrator name")("accuracy", po::value<double>(),
-                                                                    "integrator relative accuracy")(
         "no-plots", "skip the PNG plots");
+    study::addIntegratorOptions(opts);
     const auto vm = study::parse("ch7_open_loop", "open-loop lane changes and circle of the nonlinear bicycle (7.2)",
                                  argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
@@ -76,8 +75,7 @@ int main(int argc, char** argv) {
     SimulationSettings base;
     base.report_interval_s = data.number("report_interval_s");
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
-    if (vm.count("integrator")) base.integrator.method = vm["integrator"].as<std::string>();
-    if (vm.count("accuracy")) base.integrator.accuracy = vm["accuracy"].as<double>();
+    study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
     const std::string out = study::outputDir(vm, "ch7_open_loop");
     const auto wall0 = std::chrono::steady_clock::now();

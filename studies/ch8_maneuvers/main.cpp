@@ -174,12 +174,11 @@ int main(int argc, char** argv) {
         "c2_per_deg2}]); default: the data file's kr_table")(
         "scenario", po::value<std::string>(), "comma-separated scenario ids to run (default: all)")(
         "strategy", po::value<std::string>(), "comma-separated strategies: 2ws, linear, nonlinear (default: all)")(
-        "integrator", po::value<std::string>(), "integrator name")("accuracy", po::value<double>(),
-                                                                    "integrator relative accuracy")(
         "lane-change-length", po::value<std::string>(),
         "how the seed's lane-change distance reads: 'full' (DESIGN.md: the whole lane change, X_f - X_0) or "
         "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
         "no-plots", "skip the PNG plots");
+    study::addIntegratorOptions(opts);
     const auto vm = study::parse("ch8_maneuvers",
                                  "lane changes and J-turns of the 4WS vehicle under three rear-steer strategies (ch. 8)",
                                  argc, argv, opts);
@@ -192,8 +191,7 @@ int main(int argc, char** argv) {
     SimulationSettings base;
     base.report_interval_s = data.number("report_interval_s");
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
-    if (vm.count("integrator")) base.integrator.method = vm["integrator"].as<std::string>();
-    if (vm.count("accuracy")) base.integrator.accuracy = vm["accuracy"].as<double>();
+    study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
 
     const std::string reading = vm.count("lane-change-length") ? vm["lane-change-length"].as<std::string>()

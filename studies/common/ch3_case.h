@@ -28,9 +28,8 @@ struct Ch3Case {
     opts.add_options()("speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
         "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
         "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
-        "t-end-s", po::value<double>(), tEndHelp.c_str())(
-        "integrator", po::value<std::string>(), "rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
-        "accuracy", po::value<double>(), "integrator relative accuracy");
+        "t-end-s", po::value<double>(), tEndHelp.c_str());
+    addIntegratorOptions(opts);
   }
 
   /// The data file's case; options in `vm` (if given) override it.
@@ -48,8 +47,7 @@ struct Ch3Case {
     c.sim.t_end_s = has("t-end-s") ? (*vm)["t-end-s"].as<double>() : simData.number("t_end_s");
     c.sim.report_interval_s = simData.number("report_interval_s");
     c.sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
-    if (has("integrator")) c.sim.integrator.method = (*vm)["integrator"].as<std::string>();
-    if (has("accuracy")) c.sim.integrator.accuracy = (*vm)["accuracy"].as<double>();
+    if (vm) applyIntegratorOptions(*vm, c.sim.integrator);
     requirePositive(c.speed_m_s, "--speed-m-s");
     requirePositive(c.sim.t_end_s, "--t-end-s");
     return c;

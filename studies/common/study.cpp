@@ -134,4 +134,15 @@ void endProgress() {
   if (interactive()) std::fprintf(stderr, "\r\033[K");
 }
 
+void addIntegratorOptions(po::options_description& options) {
+  options.add_options()("integrator", po::value<std::string>(),
+                        "integrator: rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
+      "accuracy", po::value<double>(), "integrator relative accuracy (dimensionless)");
+}
+
+void applyIntegratorOptions(const po::variables_map& vm, IntegratorSettings& settings) {
+  if (vm.count("integrator")) settings.method = vm["integrator"].as<std::string>();
+  if (vm.count("accuracy")) settings.accuracy = vm["accuracy"].as<double>();
+}
+
 }  // namespace vdyn::study

@@ -10,6 +10,7 @@
 #include <boost/program_options.hpp>
 #include <SimTKcommon.h>
 
+#include "vdyn/core/integrators.h"
 #include "vdyn/core/params.h"
 
 namespace vdyn::study {
@@ -23,6 +24,11 @@ int run(const std::string& study, const std::function<void()>& body);
 /// and exits 0. Throws Error on unknown or malformed options.
 po::variables_map parse(const std::string& study, const std::string& summary, int argc, char** argv,
                         po::options_description& options);
+
+/// Adds --integrator NAME and --accuracy X (every study that integrates takes them).
+void addIntegratorOptions(po::options_description& options);
+/// Applies --integrator and --accuracy, where given, over `settings` (read from a data file).
+void applyIntegratorOptions(const po::variables_map& vm, IntegratorSettings& settings);
 
 /// The output folder (created): --out, or <repo>/results/<study>.
 std::string outputDir(const po::variables_map& vm, const std::string& study);

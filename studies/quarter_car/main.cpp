@@ -15,11 +15,10 @@ int main(int argc, char** argv) {
     study::po::options_description opts("Options");
     opts.add_options()("data", study::po::value<std::string>()->default_value("quarter_car.json"),
                        "quarter-car data file (path, or a name in vehicles/data)")(
-        "integrator", study::po::value<std::string>(), "integrator: rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
-        "accuracy", study::po::value<double>(), "integrator relative accuracy (dimensionless)")(
         "t-end-s", study::po::value<double>(), "simulated time T, s (seed: 1 s)")(
         "report-interval-s", study::po::value<double>(), "sampling interval of the histories, s")(
         "no-plots", "skip the PNG plots");
+    study::addIntegratorOptions(opts);
     const auto vm = study::parse("quarter_car", "chapter 4 quarter car on a sine road, cost psi = int z''^2 dt",
                                  argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
@@ -29,8 +28,7 @@ int main(int argc, char** argv) {
     sim.t_end_s = simData.number("t_end_s");
     sim.report_interval_s = simData.number("report_interval_s");
     sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
-    if (vm.count("integrator")) sim.integrator.method = vm["integrator"].as<std::string>();
-    if (vm.count("accuracy")) sim.integrator.accuracy = vm["accuracy"].as<double>();
+    study::applyIntegratorOptions(vm, sim.integrator);
     if (vm.count("t-end-s")) sim.t_end_s = vm["t-end-s"].as<double>();
     if (vm.count("report-interval-s")) sim.report_interval_s = vm["report-interval-s"].as<double>();
     requirePositive(sim.t_end_s, "--t-end-s");
