@@ -180,7 +180,8 @@ Eigen::VectorXd SteadyStateSolver::calcEquations(const Eigen::VectorXd& x) const
 void SteadyStateSolver::calcJacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& r, Eigen::MatrixXd& J) const {
   J.resize(n_, n_);
   // Multiplier columns are exact: d r / d lambda = [G^T; 0].
-  calcEquations(x);  // leaves the workspace at x
+  setUnknowns(x);  // G depends on q (and, for velocity constraints, on u)
+  scene_.getSystem().realize(se_, SimTK::Stage::Velocity);
   SimTK::Vector e(m_, 0.0), col;
   for (int j = 0; j < m_; ++j) {
     e[j] = 1.0;
@@ -262,14 +263,17 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
   };
   const bool debug = std::getenv("VDYN_DEBUG_STEADY") != nullptr;
   bool fresh = false;  // J_ was computed at the current x
-  if (!haveJacobian_ || !opt_.broyden || opt_.fresh_jacobian_each_solve) {
-    calcJacobian(x, r, J_);
-    ++res.jacobians;
-    haveJacobian_ = fresh = true;
-  }
+  // A start that already solves the equations needs no Jacobian.
+  bool needJacobian = !haveJacobian_ || !opt_.broyden || opt_.fresh_jacobian_each_solve;
   bool stalled = false;
   for (res.iterations = 0; !converged(r); ++res.iterations) {
     if (res.iterations == opt_.max_iterations) break;
+    if (needJacobian) {
+      calcJacobian(x, r, J_);
+      ++res.jacobians;
+      haveJacobian_ = fresh = true;
+      needJacobian = false;
+    }
     // Equilibrated solve: rows to newtons, columns to typical sizes.
     const Eigen::MatrixXd Js = rScale_.asDiagonal() * J_ * xScale_.asDiagonal();
     Eigen::VectorXd dx = xScale_.cwiseProduct(Js.partialPivLu().solve(-r.cwiseProduct(rScale_)));
@@ -319,7 +323,8 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
     x = xn;
     r = rn;
   }
-  r = calcEquations(x);
+  // r is the residual at x; a rejected line-search trial may have moved the workspace.
+  setUnknowns(x);
   blocks(r, res.force_residual, res.position_error, res.velocity_error, res.rate_residual);
   res.residual_norm = merit(r);
   res.residual_evaluations = evaluations_;
