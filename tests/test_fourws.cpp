@@ -113,7 +113,7 @@ SteeredRun runSteered(std::shared_ptr<const SteeringCommand> front, std::shared_
   SimulationSettings sim;
   sim.t_end_s = tEnd;
   sim.report_interval_s = 0.01;
-  sim.integrator.accuracy = 1e-8;
+  sim.integrator.accuracy = 1e-7;
   r.run = simulate(r.car->getScene(), r.final, sim, r.rec.get());
   return r;
 }
@@ -203,7 +203,7 @@ TEST(FourWsSpeedHold, HoldsTheSpeedThroughATurnAndReportsItsForce) {
   SimulationSettings sim;
   sim.t_end_s = 2.0;
   sim.report_interval_s = 0.05;
-  sim.integrator.accuracy = 1e-8;
+  sim.integrator.accuracy = 1e-7;
   Recorder rec(car.getScene(), {"chassis.forward_speed_m_s", "chassis.lateral_speed_m_s", "speed_hold.force_N"});
   simulate(car.getScene(), s, sim, &rec);
   for (std::size_t i = 0; i < rec.size(); ++i) {

@@ -152,6 +152,9 @@ TEST(Sensitivity, MixedFinalValueAndMaximumCosts) {
     p.cost = CostFunctional::parse(cost);
     SensitivitySettings set;
     set.tolerance = tol;
+    // The maximum over time is only piecewise smooth in b (its time moves), so
+    // its reference's two perturbation sizes agree to ~2e-3, not 1e-3.
+    set.reference_agreement = std::max(tol, 1e-3);
     const SensitivityResult mixed = makeSensitivityMethod("mixed", set)->compute(p);
     const SensitivityResult ref = makeSensitivityMethod("reference", set)->compute(p);
     for (int i = 0; i < 3; ++i)

@@ -166,10 +166,11 @@ class ReferenceMethod : public SensitivityMethod {
       // removes the h^2 term; the two sizes must agree (their difference is
       // 3/4 of the h^2 error of the larger one).
       const double disagreement = std::abs(d1.d[i] - d2.d[i]);
-      if (!(disagreement <= 1e-2 * std::abs(d2.d[i]) + 1e-300))
+      const double agreement = settings().reference_agreement;
+      if (!(disagreement <= agreement * std::abs(d2.d[i]) + 1e-300))
         throw Error("reference: the central differences with relative perturbations " + formatValue(rel) + " and " +
                     formatValue(rel / 2) + " disagree for " + p.parameters[i] + ": " + formatValue(d1.d[i]) +
-                    " vs " + formatValue(d2.d[i]) + " (more than 1e-2 relative)");
+                    " vs " + formatValue(d2.d[i]) + " (more than " + formatValue(agreement) + " relative)");
       r.dpsi_db.push_back((4 * d2.d[i] - d1.d[i]) / 3);
       r.error_estimate.push_back(disagreement);
       r.perturbation.push_back(d1.delta[i]);

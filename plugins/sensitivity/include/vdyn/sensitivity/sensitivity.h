@@ -59,6 +59,9 @@ struct SensitivitySettings {
   /// second is half of it).
   double reference_accuracy = 1e-10;
   double reference_perturbation = 2e-3;
+  /// reference: largest relative disagreement of the two perturbation sizes
+  /// before the reference is refused (it measures errors down to about this).
+  double reference_agreement = 1e-3;
 };
 
 struct SensitivityResult {
