@@ -87,7 +87,18 @@ SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem prob
     throw Error("steady state: effective coordinates (" + std::to_string(qe_.size()) + ") plus effective speeds (" +
                 std::to_string(ue_.size()) + ") must equal the number of mobilities (" + std::to_string(nu_) +
                 ") so that unknowns and equations match");
-  n_ = nu_ + m_ + nz_;
+  np_ = int(problem_.parameters.size());
+  if (int(problem_.conditions.size()) != np_)
+    throw Error("steady state: " + std::to_string(np_) + " extra unknowns (parameters) but " +
+                std::to_string(problem_.conditions.size()) + " extra conditions; they must match");
+  for (const auto& p : problem_.parameters)
+    if (!p.get || !p.set || !(p.typical > 0))
+      throw Error("steady state: parameter '" + p.name + "' needs get, set and a positive typical size");
+  for (const auto& c : problem_.conditions)
+    if (!c.calc || !(c.tolerance > 0) || !(c.weight > 0))
+      throw Error("steady state: condition '" + c.name + "' needs calc, a positive tolerance and weight");
+  n_ = nu_ + m_ + nz_ + np_;
+  for (const auto& p : problem_.parameters) curP_.push_back(p.get(se_));
   // Typical sizes of the unknowns (finite-difference steps) and weights that
   // bring every equation to newtons (merit and convergence report).
   xScale_.resize(n_);
@@ -96,11 +107,13 @@ SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem prob
   for (std::size_t i = 0; i < ue_.size(); ++i) xScale_[k++] = 1.0;  // m/s or rad/s
   for (int i = 0; i < m_; ++i) xScale_[k++] = 1e3;                    // N
   for (int i = 0; i < nz_; ++i) xScale_[k++] = 1e-3;                  // tire lag states, m
+  for (const auto& p : problem_.parameters) xScale_[k++] = p.typical;
   rScale_.resize(n_);
   rScale_.head(nu_).setConstant(1.0);
   rScale_.segment(nu_, mp_).setConstant(1e6);     // N per m of constraint error
   rScale_.segment(nu_ + mp_, mv_).setConstant(1e4);  // N per m/s
-  rScale_.tail(nz_).setConstant(1e5);             // N per m/s of patch-deflection rate
+  rScale_.segment(nu_ + m_, nz_).setConstant(1e5);  // N per m/s of patch-deflection rate
+  for (int i = 0; i < np_; ++i) rScale_[nu_ + m_ + nz_ + i] = problem_.conditions[i].weight;
 }
 
 Eigen::VectorXd SteadyStateSolver::getUnknowns(const SimTK::State& se, const SimTK::Vector& lambda) const {
@@ -110,6 +123,13 @@ Eigen::VectorXd SteadyStateSolver::getUnknowns(const SimTK::State& se, const Sim
   for (int i : ue_) x[k++] = se.getU()[i];
   for (int i = 0; i < m_; ++i) x[k++] = i < lambda.size() ? lambda[i] : 0.0;
   for (int i = 0; i < nz_; ++i) x[k++] = se.getZ()[i];
+  for (const auto& p : problem_.parameters) x[k++] = p.get(se);
+  return x;
+}
+
+Eigen::VectorXd SteadyStateSolver::getUnknowns(const SteadyStateResult& r) const {
+  Eigen::VectorXd x = getUnknowns(r.euler_state, r.multipliers);
+  for (int i = 0; i < np_ && i < int(r.parameters.size()); ++i) x[nu_ + m_ + nz_ + i] = r.parameters[i];
   return x;
 }
 
@@ -122,6 +142,8 @@ void SteadyStateSolver::setGuess(const Eigen::VectorXd& x, SteadyStateResult& gu
   guess.multipliers.resize(m_);
   for (int i = 0; i < m_; ++i) guess.multipliers[i] = x[k++];
   for (int i = 0; i < nz_; ++i) g.updZ()[i] = x[k++];
+  guess.parameters.resize(np_);
+  for (int i = 0; i < np_; ++i) guess.parameters[i] = x[k++];
 }
 
 void SteadyStateSolver::setUnknowns(const Eigen::VectorXd& x) const {
@@ -149,7 +171,19 @@ void SteadyStateSolver::setUnknowns(const Eigen::VectorXd& x) const {
   if (zChanged) {
     SimTK::Vector& z = se_.updZ();
     for (int i = 0; i < nz_; ++i) z[i] = x[k++];
+  } else {
+    k += nz_;
   }
+  bool pChanged = false;
+  for (int i = 0; i < np_; ++i) {
+    const double v = x[k++];
+    if (v != curP_[i]) {
+      problem_.parameters[i].set(se_, v);
+      curP_[i] = v;
+      pChanged = true;
+    }
+  }
+  if (pChanged) se_.invalidateAll(SimTK::Stage::Position);  // the model changed
 }
 
 Eigen::VectorXd SteadyStateSolver::calcEquations(const Eigen::VectorXd& x) const {
@@ -174,6 +208,7 @@ Eigen::VectorXd SteadyStateSolver::calcEquations(const Eigen::VectorXd& x) const
   for (int i = 0; i < mp_; ++i) r[nu_ + i] = se_.getQErr()[i];
   for (int i = 0; i < mv_; ++i) r[nu_ + mp_ + i] = se_.getUErr()[mp_ + i];
   for (int i = 0; i < nz_; ++i) r[nu_ + m_ + i] = se_.getZDot()[i];
+  for (int i = 0; i < np_; ++i) r[nu_ + m_ + nz_ + i] = problem_.conditions[i].calc(se_);
   return r;
 }
 
@@ -215,20 +250,29 @@ std::string SteadyStateSolver::describeEquation(int row) const {
   }
   if (row < nu_ + mp_) return "position constraint error " + std::to_string(row - nu_);
   if (row < nu_ + m_) return "velocity constraint error " + std::to_string(row - nu_ - mp_);
-  return "auxiliary state rate zdot[" + std::to_string(row - nu_ - m_) + "]";
+  if (row < nu_ + m_ + nz_) return "auxiliary state rate zdot[" + std::to_string(row - nu_ - m_) + "]";
+  return "condition '" + problem_.conditions[row - nu_ - m_ - nz_].name + "'";
 }
 
 SteadyStateResult SteadyStateSolver::solve(const SimTK::State& guess) {
   const SimTK::State se = toEulerAngles(scene_, guess);
   haveJacobian_ = false;
-  return solveFrom(se, SimTK::Vector(m_, 0.0));
+  std::vector<double> p0;
+  for (const auto& p : problem_.parameters) p0.push_back(p.get(guess));
+  return solveFrom(se, SimTK::Vector(m_, 0.0), p0);
 }
 
 SteadyStateResult SteadyStateSolver::resolve(const SteadyStateResult& previous) {
-  return solveFrom(previous.euler_state, previous.multipliers);
+  std::vector<double> p0 = previous.parameters;
+  if (int(p0.size()) != np_) {
+    p0.clear();
+    for (const auto& p : problem_.parameters) p0.push_back(p.get(previous.euler_state));
+  }
+  return solveFrom(previous.euler_state, previous.multipliers, p0);
 }
 
-SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vector& lambda0) {
+SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vector& lambda0,
+                                               const std::vector<double>& p0) {
   const auto t0 = std::chrono::steady_clock::now();
   const SimTK::MultibodySystem& system = scene_.getSystem();
   se.setTime(problem_.time_s);
@@ -242,24 +286,32 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
   if (se.getNQ() != se_.getNQ() || se.getNU() != nu_ || se.getNZ() != nz_)
     throw Error("steady state: the start state does not belong to the solver's scene");
   se_ = se;
+  curP_ = p0;
+  for (int i = 0; i < np_; ++i) problem_.parameters[i].set(se_, p0[i]);
   se_.invalidateAll(SimTK::Stage::Position);  // commands may have changed (model parameters)
   evaluations_ = 0;
 
   SteadyStateResult res;
   Eigen::VectorXd x = getUnknowns(se_, lambda0);
+  for (int i = 0; i < np_; ++i) x[nu_ + m_ + nz_ + i] = p0[i];
   Eigen::VectorXd r = calcEquations(x);
   auto merit = [&](const Eigen::VectorXd& rr) { return rr.cwiseProduct(rScale_).norm(); };
   auto blocks = [&](const Eigen::VectorXd& rr, double& f, double& p, double& v, double& z) {
     f = maxAbs(rr.head(nu_));
     p = maxAbs(rr.segment(nu_, mp_));
     v = maxAbs(rr.segment(nu_ + mp_, mv_));
-    z = maxAbs(rr.tail(nz_));
+    z = maxAbs(rr.segment(nu_ + m_, nz_));
+  };
+  auto conditionsMet = [&](const Eigen::VectorXd& rr) {
+    for (int i = 0; i < np_; ++i)
+      if (!(std::abs(rr[nu_ + m_ + nz_ + i]) <= problem_.conditions[i].tolerance)) return false;
+    return true;
   };
   auto converged = [&](const Eigen::VectorXd& rr) {
     double f, p, v, z;
     blocks(rr, f, p, v, z);
     return f <= opt_.force_tolerance && p <= opt_.position_tolerance && v <= opt_.velocity_tolerance &&
-           z <= opt_.rate_tolerance;
+           z <= opt_.rate_tolerance && conditionsMet(rr);
   };
   const bool debug = std::getenv("VDYN_DEBUG_STEADY") != nullptr;
   bool fresh = false;  // J_ was computed at the current x
@@ -327,6 +379,7 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
   setUnknowns(x);
   blocks(r, res.force_residual, res.position_error, res.velocity_error, res.rate_residual);
   res.residual_norm = merit(r);
+  res.condition_residual = maxAbs(r.tail(np_));
   res.residual_evaluations = evaluations_;
   if (!converged(r)) {
     haveJacobian_ = false;
@@ -338,11 +391,13 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
         ", max force residual " + formatValue(res.force_residual) + " N (tolerance " +
         formatValue(opt_.force_tolerance) + "), max position-constraint error " + formatValue(res.position_error) +
         ", max velocity-constraint error " + formatValue(res.velocity_error) + ", max zdot " +
-        formatValue(res.rate_residual) + "; worst equation: " + describeEquation(int(worst)) + " = " +
-        formatValue(r[worst]));
+        formatValue(res.rate_residual) +
+        (np_ ? ", max |condition| " + formatValue(res.condition_residual) : std::string()) +
+        "; worst equation: " + describeEquation(int(worst)) + " = " + formatValue(r[worst]));
   }
   res.multipliers.resize(m_);
   for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nu_ + i];
+  res.parameters.assign(x.data() + nu_ + m_ + nz_, x.data() + n_);
   res.euler_state = se_;
   res.state = toQuaternions(scene_, se_);
   system.realize(res.state, SimTK::Stage::Velocity);
@@ -432,9 +487,44 @@ struct Reduction {
 }  // namespace
 
 StabilityResult SteadyStateSolver::calcStability(const SteadyStateResult& steady, double tol) const {
+  const LinearModel lin = calcLinearModel(steady, {}, {});
+  StabilityResult out;
+  out.dimension = int(lin.A.rows());
+  out.equilibrium_residual = lastEquilibriumResidual_;
+  const int D = out.dimension;
+  double maxRe = -1e300;
+  if (D > 0) {
+    Eigen::EigenSolver<Eigen::MatrixXd> es(lin.A, false);
+    for (int i = 0; i < D; ++i) {
+      const std::complex<double> ev = es.eigenvalues()[i];
+      out.eigenvalues.push_back(ev);
+      if (ev.real() > maxRe) maxRe = ev.real(), out.least_damped = ev;
+    }
+  }
+  std::sort(out.eigenvalues.begin(), out.eigenvalues.end(),
+            [](const auto& a, const auto& b) { return a.real() > b.real(); });
+  out.stable = D == 0 || maxRe < -tol;
+  return out;
+}
+
+Eigen::MatrixXcd LinearModel::calcResponse(double w) const {
+  const std::complex<double> jw(0, w);
+  const int D = int(A.rows());
+  const Eigen::MatrixXcd M = jw * Eigen::MatrixXcd::Identity(D, D) - A.cast<std::complex<double>>();
+  const Eigen::MatrixXcd B = B0.cast<std::complex<double>>() + jw * B1.cast<std::complex<double>>() +
+                             jw * jw * B2.cast<std::complex<double>>();
+  const Eigen::MatrixXcd Dd = D0.cast<std::complex<double>>() + jw * D1.cast<std::complex<double>>() +
+                              jw * jw * D2.cast<std::complex<double>>();
+  return C.cast<std::complex<double>>() * M.partialPivLu().solve(B) + Dd;
+}
+
+LinearModel SteadyStateSolver::calcLinearModel(const SteadyStateResult& steady, const std::vector<LinearInput>& inputs,
+                                               const std::vector<LinearOutput>& outputs) const {
   const SimTK::MultibodySystem& system = scene_.getSystem();
   const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
   SimTK::State s = steady.euler_state;
+  for (int i = 0; i < np_ && i < int(steady.parameters.size()); ++i) problem_.parameters[i].set(s, steady.parameters[i]);
+  s.invalidateAll(SimTK::Stage::Position);
   system.realize(s, SimTK::Stage::Instance);
   Reduction red;
   red.system = &system;
@@ -457,6 +547,11 @@ StabilityResult SteadyStateSolver::calcStability(const SteadyStateResult& steady
   const Eigen::VectorXd r0 = red.fromState(s);
   red.toState(r0, s);
   const int N = red.size();
+  const int ni = int(inputs.size()), no = int(outputs.size());
+  auto setInput = [&](int k, double v, double vd, double vdd) {
+    inputs[k].set(s, v, vd, vdd);
+    s.invalidateAll(SimTK::Stage::Position);
+  };
 
   // Tangent space of the constraint manifold: null space of d[qerr; uerr]/dr.
   const int nc = s.getNQErr() + s.getNUErr();
@@ -479,41 +574,69 @@ StabilityResult SteadyStateSolver::calcStability(const SteadyStateResult& steady
     C.col(j) = (cp - constraintErrors(s)) / (2 * h);
   }
   Eigen::MatrixXd T;
+  Eigen::MatrixXd Cpinv = Eigen::MatrixXd::Zero(N, nc);  // pseudo-inverse of C
   if (nc > 0) {
-    Eigen::JacobiSVD<Eigen::MatrixXd> svd(C, Eigen::ComputeFullV);
+    Eigen::JacobiSVD<Eigen::MatrixXd> svd(C, Eigen::ComputeFullV | Eigen::ComputeFullU);
     const auto& sv = svd.singularValues();
     int rank = 0;
     for (int i = 0; i < sv.size(); ++i) rank += sv[i] > 1e-8 * sv[0];
     T = svd.matrixV().rightCols(N - rank);
+    for (int i = 0; i < rank; ++i) Cpinv += svd.matrixV().col(i) * svd.matrixU().col(i).transpose() / sv[i];
   } else {
     T = Eigen::MatrixXd::Identity(N, N);
   }
   const int D = int(T.cols());
-  // A = T^T (d rate / d r) T by central differences along the tangent directions.
+  // State rate and outputs at a reduced state (outputs need Acceleration: rate() realizes it).
+  auto rateAndOutputs = [&](const Eigen::VectorXd& r) {
+    red.toState(r, s);
+    Eigen::VectorXd d(N + no);
+    d.head(N) = red.rate(s);
+    for (int k = 0; k < no; ++k) d[N + k] = outputs[k].calc(s);
+    return d;
+  };
   red.toState(r0, s);
-  StabilityResult out;
-  out.dimension = D;
-  out.equilibrium_residual = maxAbs(red.rate(s));
-  Eigen::MatrixXd JT(N, D);
+  lastEquilibriumResidual_ = maxAbs(red.rate(s));
+  LinearModel lin;
+  for (const auto& i : inputs) lin.inputs.push_back(i.name);
+  for (const auto& o : outputs) lin.outputs.push_back(o.name);
+  // A = T^T (d rate / d r) T and C by central differences along the tangent directions.
+  Eigen::MatrixXd JT(N + no, D);
   const double h = 1e-6;
-  for (int j = 0; j < D; ++j) {
-    red.toState(r0 + h * T.col(j), s);
-    const Eigen::VectorXd dp = red.rate(s);
-    red.toState(r0 - h * T.col(j), s);
-    JT.col(j) = (dp - red.rate(s)) / (2 * h);
+  for (int j = 0; j < D; ++j) JT.col(j) = (rateAndOutputs(r0 + h * T.col(j)) - rateAndOutputs(r0 - h * T.col(j))) / (2 * h);
+  lin.A = T.transpose() * JT.topRows(N);
+  lin.C = JT.bottomRows(no);
+  lin.B0.resize(D, ni), lin.B1.resize(D, ni), lin.B2.resize(D, ni);
+  lin.D0.resize(no, ni), lin.D1.resize(no, ni), lin.D2.resize(no, ni);
+  for (int k = 0; k < ni; ++k) {
+    const double hk = 1e-3 * inputs[k].typical;
+    for (int level = 0; level < 3; ++level) {
+      auto apply = [&](double sgn) {
+        setInput(k, level == 0 ? sgn * hk : 0, level == 1 ? sgn * hk : 0, level == 2 ? sgn * hk : 0);
+      };
+      // The particular displacement that keeps the state on the moved constraint
+      // manifold (the acceleration level moves no state): X = -C^+ dc/dv.
+      Eigen::VectorXd X = Eigen::VectorXd::Zero(N);
+      if (level < 2 && nc > 0) {
+        red.toState(r0, s);
+        apply(+1);
+        const Eigen::VectorXd cp = constraintErrors(s);
+        apply(-1);
+        const Eigen::VectorXd cm = constraintErrors(s);
+        X = -Cpinv * ((cp - cm) / (2 * hk));
+      }
+      apply(+1);
+      const Eigen::VectorXd dp = rateAndOutputs(r0 + hk * X);
+      apply(-1);
+      const Eigen::VectorXd dm = rateAndOutputs(r0 - hk * X);
+      const Eigen::VectorXd d = (dp - dm) / (2 * hk);
+      Eigen::MatrixXd& B = level == 0 ? lin.B0 : level == 1 ? lin.B1 : lin.B2;
+      Eigen::MatrixXd& Dm = level == 0 ? lin.D0 : level == 1 ? lin.D1 : lin.D2;
+      B.col(k) = T.transpose() * d.head(N);
+      Dm.col(k) = d.tail(no);
+    }
+    setInput(k, 0, 0, 0);
   }
-  const Eigen::MatrixXd A = T.transpose() * JT;
-  Eigen::EigenSolver<Eigen::MatrixXd> es(A, false);
-  double maxRe = -1e300;
-  for (int i = 0; i < D; ++i) {
-    const std::complex<double> ev = es.eigenvalues()[i];
-    out.eigenvalues.push_back(ev);
-    if (ev.real() > maxRe) maxRe = ev.real(), out.least_damped = ev;
-  }
-  std::sort(out.eigenvalues.begin(), out.eigenvalues.end(),
-            [](const auto& a, const auto& b) { return a.real() > b.real(); });
-  out.stable = D == 0 || maxRe < -tol;
-  return out;
+  return lin;
 }
 
 // --- continuation and sensitivity ------------------------------------------------
@@ -533,7 +656,7 @@ std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, cons
     std::vector<Eigen::VectorXd> xs;
     for (std::size_t i = branch.size() - k; i < branch.size(); ++i) {
       vs.push_back(branch[i].first);
-      xs.push_back(solver.getUnknowns(branch[i].second.euler_state, branch[i].second.multipliers));
+      xs.push_back(solver.getUnknowns(branch[i].second));
     }
     for (std::size_t i = 0; i < k; ++i)
       for (std::size_t j = i + 1; j < k; ++j)

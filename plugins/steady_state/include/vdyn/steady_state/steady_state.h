@@ -33,6 +33,27 @@
 
 namespace vdyn {
 
+/// A model parameter solved for as an extra unknown (e.g. the held steering
+/// angle of a constant-radius test). It is not a state variable: set() changes
+/// the model (e.g. HoldCommand::setAngle) and the solver re-realizes from
+/// Stage::Position after every change.
+struct SteadyStateParameter {
+  std::string name;        ///< for messages, e.g. "front steering angle (rad)"
+  double typical = 0.01;   ///< typical size, in the parameter's unit (finite-difference step scale)
+  std::function<double(const SimTK::State&)> get;
+  std::function<void(SimTK::State&, double)> set;
+};
+
+/// An extra equation c(state) = 0, one per extra unknown (e.g. the speed
+/// relation U - r R = 0 of a constant-radius test).
+struct SteadyStateCondition {
+  std::string name;        ///< for messages, e.g. "path radius: r R - U (m/s)"
+  double tolerance = 1e-12;  ///< converged when |c| <= tolerance, unit of c
+  double weight = 1e4;     ///< merit weight: newtons per unit of c
+  /// c on a state realized to Stage::Velocity.
+  std::function<double(const SimTK::State&)> calc;
+};
+
 /// Declared by the vehicle / manoeuvre. Indices refer to the Euler-angle state
 /// (SimbodyMatterSubsystem::convertToEulerAngles), where nq == nu.
 struct SteadyStateProblem {
@@ -54,6 +75,11 @@ struct SteadyStateProblem {
   /// Coordinates the stability analysis leaves out besides the base's x, y and
   /// yaw: ones no force depends on (wheel spin angles). Euler-state q indices.
   std::vector<int> cyclic_q;
+  /// Extra unknowns (model parameters) and as many extra equations: e.g. the
+  /// steering angle and the path-radius relation U = r R (ISO 4138 constant
+  /// radius), or the steering angle and a lateral acceleration U r = a_y.
+  std::vector<SteadyStateParameter> parameters;
+  std::vector<SteadyStateCondition> conditions;
 };
 
 /// A steady turn of a vehicle with a free-mobilizer chassis on a flat road:
@@ -101,6 +127,10 @@ struct SteadyStateResult {
   double rate_residual = 0;        ///< max |zdot|
   double residual_norm = 0;        ///< scaled 2-norm of all equations
   SimTK::Vector multipliers;       ///< lambda (Simbody's order and sign)
+  /// Values of the problem's extra unknowns (SteadyStateProblem::parameters),
+  /// in their order; the model is left set to them.
+  std::vector<double> parameters;
+  double condition_residual = 0;   ///< max |extra condition| (its own unit)
   double wall_time_s = 0;
 };
 
@@ -112,6 +142,39 @@ struct StabilityResult {
   std::vector<std::complex<double>> eigenvalues;
   int dimension = 0;               ///< independent states linearised
   double equilibrium_residual = 0; ///< max |reduced state rate| at the point (should be ~0)
+};
+
+/// An input of the linearisation (e.g. a steering command): set(state, v,
+/// v', v'') applies the input's deviation v from its steady value and its
+/// first two time derivatives to the model (the steering command's angle,
+/// rate and acceleration); the solver re-realizes from Stage::Position.
+struct LinearInput {
+  std::string name;
+  double typical = 1e-3;  ///< finite-difference step scale, unit of the input
+  std::function<void(SimTK::State&, double v, double vdot, double vddot)> set;
+};
+
+/// An output of the linearisation, evaluated on a state whose floating base
+/// has zero yaw (so ground x is the heading, ground y its left), realized to
+/// Stage::Acceleration.
+struct LinearOutput {
+  std::string name;
+  std::function<double(const SimTK::State&)> calc;
+};
+
+/// The equations of motion linearised about a steady state on the constraint
+/// manifold, in D independent coordinates xi (tangent directions):
+///     xi' = A xi + B0 v + B1 v' + B2 v''
+///     y   = C xi + D0 v + D1 v' + D2 v''   (deviations from the steady state)
+/// Inputs that move the constraints (a commanded steering angle and its rate)
+/// carry their particular state displacement into B0, B1, D0, D1; the
+/// commanded acceleration enters the acceleration-level constraint (B2, D2).
+struct LinearModel {
+  Eigen::MatrixXd A, B0, B1, B2, C, D0, D1, D2;
+  std::vector<std::string> inputs, outputs;
+  /// Frequency response y/v at omega (rad/s): C (j w I - A)^-1 (B0 + j w B1 -
+  /// w^2 B2) + D0 + j w D1 - w^2 D2 (outputs x inputs).
+  Eigen::MatrixXcd calcResponse(double omega_rad_s) const;
 };
 
 class SteadyStateSolver {
@@ -132,13 +195,21 @@ class SteadyStateSolver {
   /// the frame turning with the floating base, and returns the eigenvalues.
   /// Stable when every real part is below -tolerance_per_s.
   StabilityResult calcStability(const SteadyStateResult& steady, double tolerance_per_s = 1e-6) const;
+  /// The same linearisation with input columns and output rows (central
+  /// differences; steps 1e-6 of the state's tangent directions and
+  /// 1e-3 x typical of each input). calcStability's A is this A.
+  LinearModel calcLinearModel(const SteadyStateResult& steady, const std::vector<LinearInput>& inputs,
+                              const std::vector<LinearOutput>& outputs) const;
 
   const SteadyStateProblem& problem() const { return problem_; }
   const SteadyStateOptions& options() const { return opt_; }
   SteadyStateOptions& updOptions() { return opt_; }
 
-  /// Unknowns of the Euler-angle state `se` with multipliers `lambda`, and back.
+  /// Unknowns of the Euler-angle state `se` with multipliers `lambda` (extra
+  /// parameters as the model holds them now), and back.
   Eigen::VectorXd getUnknowns(const SimTK::State& se, const SimTK::Vector& lambda) const;
+  /// Unknowns of a result (its euler_state, multipliers and parameters).
+  Eigen::VectorXd getUnknowns(const SteadyStateResult& r) const;
   /// Writes unknowns x into a result used as a start for resolve().
   void setGuess(const Eigen::VectorXd& x, SteadyStateResult& guess) const;
   /// The equations at unknowns x, unscaled (for tests).
@@ -147,7 +218,7 @@ class SteadyStateSolver {
 
  private:
   void setUnknowns(const Eigen::VectorXd& x) const;
-  SteadyStateResult solveFrom(SimTK::State se, const SimTK::Vector& lambda0);
+  SteadyStateResult solveFrom(SimTK::State se, const SimTK::Vector& lambda0, const std::vector<double>& p0);
   void calcJacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& r, Eigen::MatrixXd& J) const;
   std::string describeEquation(int row) const;
 
@@ -156,7 +227,9 @@ class SteadyStateSolver {
   SteadyStateOptions opt_;
   std::vector<int> qAll_;     // q indices in use (Euler state)
   std::vector<int> qe_, ue_;  // effective q and u (Euler state)
-  int nq_ = 0, nu_ = 0, nz_ = 0, mp_ = 0, mv_ = 0, m_ = 0, n_ = 0;
+  int nq_ = 0, nu_ = 0, nz_ = 0, mp_ = 0, mv_ = 0, m_ = 0, np_ = 0, n_ = 0;
+  mutable std::vector<double> curP_;  // parameter values the model holds now
+  mutable double lastEquilibriumResidual_ = 0;  // max |reduced rate| at the last linearisation point
   Eigen::VectorXd xScale_, rScale_;  // typical sizes of unknowns; equation weights
   mutable SimTK::State se_;           // workspace (Euler-angle form)
   mutable int evaluations_ = 0;

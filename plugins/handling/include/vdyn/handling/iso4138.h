@@ -1,0 +1,77 @@
+#pragma once
+// ISO 4138 steady-state circular driving, constant-radius method, as a direct
+// steady-state solve (plugins/steady_state): the path radius R of the chassis
+// origin is fixed by the extra condition U_h - r R = 0 (U_h its horizontal
+// speed, r the yaw rate) and the front steering angle is the extra unknown;
+// the speed U0 (3.18) is continued upward until no steady state exists (the
+// limit, located by bisection) or speed_max_m_s. At each point: steering
+// angle, side slip, roll angle, lateral acceleration a_y (along the heading's
+// horizontal left, = U_h r cos(beta)), the
+// understeer gradient d delta_f / d a_y (deg per m/s^2) and the fixed-control
+// stability verdict (eigenvalues of the linearisation).
+#include <complex>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "vdyn/handling/handling.h"
+
+namespace vdyn {
+
+struct ConstantRadiusSettings {
+  /// Keys radius_m, speed_start_m_s, speed_step_m_s, speed_max_m_s,
+  /// limit_tolerance_m_s, stability (each optional; defaults below).
+  static ConstantRadiusSettings fromParams(const ParamReader& r);
+
+  double radius_m = 100;              ///< R, path radius of the chassis origin, m (> 0; + = left turn)
+  double speed_start_m_s = 4;         ///< first speed, m/s
+  double speed_step_m_s = 1;          ///< speed increment of the sweep, m/s
+  double speed_max_m_s = 60;          ///< last speed tried if the limit is not met first, m/s
+  double limit_tolerance_m_s = 0.005; ///< the limit speed is bisected to this, m/s
+  bool stability = true;              ///< linearise at each point (eigenvalues)
+  SteadyStateOptions solver;
+  void validate() const;
+};
+
+struct ConstantRadiusPoint {
+  double speed_m_s = 0;               ///< U0 held (3.18), m/s
+  double lateral_accel_m_s2 = 0;      ///< a_y = U_h r cos(beta) (calcSteadyLateralAcceleration), m/s^2
+  double front_rad = 0, rear_rad = 0; ///< road-wheel angles, rad
+  double side_slip_rad = 0;           ///< chassis origin (3.20), rad
+  double roll_rad = 0;                ///< chassis roll, rad
+  double yaw_rate_rad_s = 0;
+  double path_radius_m = 0;           ///< U_h / r of the chassis origin (= R to the condition's tolerance), m
+  /// d delta_f / d a_y along the sweep (three-point differences), rad/(m/s^2).
+  double understeer_gradient_rad_per_m_s2 = 0;
+  bool stable = true;                 ///< fixed-control stability (all eigenvalue real parts < -1e-6 /s)
+  std::complex<double> least_damped;  ///< 1/s
+  int iterations = 0, residual_evaluations = 0;
+  double solve_wall_time_s = 0, stability_wall_time_s = 0;
+};
+
+struct ConstantRadiusResult {
+  double radius_m = 0;
+  std::vector<ConstantRadiusPoint> points;  ///< ascending speed (bisection points of the limit included)
+  double limit_speed_m_s = 0;               ///< last speed with a steady state, m/s
+  double limit_lateral_accel_m_s2 = 0;      ///< a_y there, m/s^2
+  bool limit_found = false;                 ///< false: speed_max_m_s reached with a steady state
+  std::string limit_reason;                 ///< the solver's message beyond the limit
+  /// First speed / lateral acceleration without stability (NaN if stable throughout),
+  /// linearly interpolated on the least-damped real part between the last stable
+  /// and the first unstable point.
+  double stability_lost_speed_m_s = std::numeric_limits<double>::quiet_NaN();
+  double stability_lost_lateral_accel_m_s2 = std::numeric_limits<double>::quiet_NaN();
+  /// Understeer gradient at the lowest lateral acceleration (linear range), rad/(m/s^2).
+  double understeer_gradient_linear_rad_per_m_s2 = 0;
+  double wheelbase_m = 0;
+  double solve_wall_time_s = 0;       ///< sum of the steady-state solves (incl. the limit's bisection)
+  double stability_wall_time_s = 0;   ///< sum of the linearisations
+  double wall_time_s = 0;             ///< whole analysis
+  int residual_evaluations = 0;
+};
+
+/// Runs the constant-radius test on a vehicle (front angle held; rear angle
+/// from its strategy). Throws Error if no steady state exists at the first speed.
+ConstantRadiusResult runConstantRadius(const HandlingVehicle& vehicle, const ConstantRadiusSettings& settings);
+
+}  // namespace vdyn

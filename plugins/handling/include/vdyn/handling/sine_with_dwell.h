@@ -1,0 +1,64 @@
+#pragma once
+// Sine with dwell (FMVSS 126, S6-S7): the angle A that gives 0.3 g of steady
+// lateral acceleration at 80 km/h (the regulation's slowly increasing steer
+// reads it from a quasi-steady ramp; here its limit, the steady-state solve at
+// that lateral acceleration), then a 0.7 Hz sine whose second peak is held for
+// a 500 ms dwell, at amplitudes 1.5 A, 2 A, ... up to the largest of
+// max_amplitude_factor A and max_amplitude_rad. Per run: the yaw-rate ratios
+// at 1.0 s and 1.75 s after the completion of steer (COS) to the first yaw-rate
+// peak after the steering changes sign, and the lateral displacement of the
+// chassis origin 1.07 s after the beginning of steer (BOS), against the
+// regulation's limits: <= 35 %, <= 20 %, >= 1.83 m (GVWR <= 3500 kg; required
+// from 5 A). Deviation: the speed is held (3.18) instead of coasting.
+#include <string>
+#include <vector>
+
+#include "vdyn/handling/handling.h"
+
+namespace vdyn {
+
+struct SineWithDwellSettings {
+  /// Keys as the fields (speed_m_s, lateral_accel_m_s2, frequency_Hz, dwell_s,
+  /// start_s, after_s, first_factor, factor_step, max_amplitude_factor,
+  /// max_amplitude_rad, sample_s, integrator), each optional.
+  static SineWithDwellSettings fromParams(const ParamReader& r);
+
+  double speed_m_s = 80.0 / 3.6;      ///< m/s (80 km/h)
+  double lateral_accel_m_s2 = 0.3 * 9.81;  ///< a_y defining A, m/s^2 (0.3 g)
+  double frequency_Hz = 0.7;
+  double dwell_s = 0.5;
+  double start_s = 0.5;               ///< beginning of steer (BOS), s
+  double after_s = 2.5;               ///< simulated time after COS, s
+  double first_factor = 1.5;          ///< first amplitude / A
+  double factor_step = 0.5;           ///< increment of amplitude / A
+  double max_amplitude_factor = 6.5;  ///< last amplitude / A (the regulation's 6.5 A or 270 deg at the wheel)
+  double max_amplitude_rad = 0.35;    ///< cap on the road-wheel amplitude, rad
+  double yaw_ratio_1s_limit = 0.35, yaw_ratio_175_limit = 0.20;  ///< 1
+  double displacement_limit_m = 1.83;       ///< at 1.07 s after BOS, m
+  double displacement_from_factor = 5.0;    ///< the displacement limit applies from this amplitude / A
+  double sample_s = 0.002;
+  IntegratorSettings integrator;
+  SineWithDwellSettings() { integrator.accuracy = 1e-6; }
+  void validate() const;
+};
+
+struct SineWithDwellRun {
+  double factor = 0, amplitude_rad = 0;
+  bool completed = false;            ///< false: spin-out or failed run (reason)
+  std::string reason;
+  double peak_yaw_rate_rad_s = 0;    ///< first peak after the steering changes sign
+  double yaw_ratio_1s = 0, yaw_ratio_175 = 0;  ///< yaw rate at COS + 1.0 / 1.75 s over the peak
+  double lateral_displacement_m = 0;  ///< at BOS + 1.07 s, + toward the first steer
+  bool pass = false;
+  HandlingHistory history;
+};
+
+struct SineWithDwellResult {
+  double angle_A_rad = 0;            ///< front angle at lateral_accel_m_s2 (steady state)
+  std::vector<SineWithDwellRun> runs;
+  bool pass = false;                 ///< every run within the limits
+};
+
+SineWithDwellResult runSineWithDwell(const HandlingVehicle& vehicle, const SineWithDwellSettings& settings);
+
+}  // namespace vdyn

@@ -1,0 +1,333 @@
+// handling: the standard handling tests by name (plugins/handling) on the
+// App. A 4WS vehicle (rear-steer strategies 2ws, linear, nonlinear) and the
+// nonlinear bicycle: ISO 4138 constant radius (steady-state solves continued in
+// speed), ISO 7401 step steer and frequency response (linearisation, checked
+// against sine-steer simulations), FMVSS 126 sine with dwell. CSV per run,
+// PNG plots, summary.json, printed tables and the 2WS/4WS ranking.
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <sstream>
+
+#include "study.h"
+#include "vdyn/handling/iso4138.h"
+#include "vdyn/handling/iso7401.h"
+#include "vdyn/handling/sine_with_dwell.h"
+#include "vdyn/vehicles/handling_vehicles.h"
+
+using namespace vdyn;
+
+namespace {
+const double kDeg = SimTK::Pi / 180;
+
+std::vector<std::string> splitList(const std::string& s) {
+  std::vector<std::string> out;
+  std::stringstream ss(s);
+  std::string item;
+  while (std::getline(ss, item, ','))
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+struct Config {
+  ParamReader data;
+  FourWsParams fourws;
+  BicycleParams bicycle;
+  LinearBicycleParams linear;
+  KrTable table;
+  double tire_width_m;
+};
+
+std::unique_ptr<HandlingBuild> build(const Config& c, const std::string& vehicle) {
+  if (vehicle == "bicycle") return makeHandlingBicycle(c.bicycle, c.tire_width_m);
+  const std::string strategy = vehicle.substr(4);  // "4ws/<strategy>"
+  return makeHandlingFourWs(c.fourws, strategy, c.linear, &c.table, c.tire_width_m);
+}
+
+std::string fileTag(const std::string& vehicle) {
+  std::string t = vehicle;
+  for (char& ch : t)
+    if (ch == '/') ch = '_';
+  return t;
+}
+
+Json iso4138(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
+  Json j = Json::array();
+  const ParamReader p = c.data.child("iso4138");
+  std::vector<study::Series> sd, sb, sr, sk, hd;
+  for (double R : p.numbers("radii_m")) {
+    auto b = build(c, vehicle);
+    ConstantRadiusSettings set = ConstantRadiusSettings::fromParams(p);
+    set.radius_m = R;
+    const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
+    const std::string csv = out + "/iso4138_" + fileTag(vehicle) + "_R" + formatValue(R) + ".csv";
+    std::ofstream f(csv);
+    f << "speed_m_s,lateral_accel_m_s2,front_deg,rear_deg,side_slip_deg,roll_deg,yaw_rate_rad_s,"
+         "understeer_gradient_deg_per_m_s2,delta_minus_l_over_R_deg,stable,least_damped_re_per_s,least_damped_im_per_s,"
+         "iterations\n";
+    f.precision(10);
+    Json pts = Json::array();
+    for (const auto& q : r.points) {
+      f << q.speed_m_s << ',' << q.lateral_accel_m_s2 << ',' << q.front_rad / kDeg << ',' << q.rear_rad / kDeg << ','
+        << q.side_slip_rad / kDeg << ',' << q.roll_rad / kDeg << ',' << q.yaw_rate_rad_s << ','
+        << q.understeer_gradient_rad_per_m_s2 / kDeg << ',' << (q.front_rad - r.wheelbase_m / R) / kDeg << ','
+        << int(q.stable) << ',' << q.least_damped.real() << ',' << q.least_damped.imag() << ',' << q.iterations << '\n';
+    }
+    f.close();
+    auto usAt = [&](double ay) {
+      // Understeer gradient at a lateral acceleration (linear interpolation along the sweep).
+      std::vector<double> x, y;
+      for (const auto& q : r.points) x.push_back(q.lateral_accel_m_s2), y.push_back(q.understeer_gradient_rad_per_m_s2);
+      return ay <= r.limit_lateral_accel_m_s2 ? interpolate(x, y, ay) / kDeg : std::nan("");
+    };
+    Json jr = {{"radius_m", R},
+               {"points", r.points.size()},
+               {"limit_found", r.limit_found},
+               {"limit_speed_m_s", r.limit_speed_m_s},
+               {"limit_lateral_accel_m_s2", r.limit_lateral_accel_m_s2},
+               {"understeer_gradient_linear_deg_per_m_s2", r.understeer_gradient_linear_rad_per_m_s2 / kDeg},
+               {"understeer_gradient_at_2_m_s2_deg_per_m_s2", usAt(2)},
+               {"understeer_gradient_at_4_m_s2_deg_per_m_s2", usAt(4)},
+               {"understeer_gradient_at_6_m_s2_deg_per_m_s2", usAt(6)},
+               {"stability_lost_speed_m_s", r.stability_lost_speed_m_s},
+               {"stability_lost_lateral_accel_m_s2", r.stability_lost_lateral_accel_m_s2},
+               {"solve_wall_time_s", r.solve_wall_time_s},
+               {"stability_wall_time_s", r.stability_wall_time_s},
+               {"wall_time_s", r.wall_time_s},
+               {"residual_evaluations", r.residual_evaluations},
+               {"csv", csv}};
+    if (!std::isfinite(r.stability_lost_speed_m_s)) jr["stability_lost_speed_m_s"] = nullptr, jr["stability_lost_lateral_accel_m_s2"] = nullptr;
+    for (const char* k : {"understeer_gradient_at_2_m_s2_deg_per_m_s2", "understeer_gradient_at_4_m_s2_deg_per_m_s2",
+                          "understeer_gradient_at_6_m_s2_deg_per_m_s2"})
+      if (!std::isfinite(jr[k].get<double>())) jr[k] = nullptr;
+    j.push_back(jr);
+    std::printf("  ISO 4138 %-14s R %5.0f m: %2zu points, limit a_y %.3f m/s^2 at %.3f m/s%s, K(0) %+.4f deg/(m/s^2), "
+                "stability lost %s, %.3f s (solves %.3f s)\n",
+                vehicle.c_str(), R, r.points.size(), r.limit_lateral_accel_m_s2, r.limit_speed_m_s,
+                r.limit_found ? "" : " (speed_max)", r.understeer_gradient_linear_rad_per_m_s2 / kDeg,
+                std::isfinite(r.stability_lost_lateral_accel_m_s2)
+                    ? ("at " + formatValue(r.stability_lost_lateral_accel_m_s2) + " m/s^2").c_str()
+                    : "never",
+                r.wall_time_s, r.solve_wall_time_s);
+    const std::string lab = "R " + formatValue(R) + " m";
+    sd.push_back({csv, "lateral_accel_m_s2", "front_deg", lab});
+    sb.push_back({csv, "lateral_accel_m_s2", "side_slip_deg", lab});
+    sr.push_back({csv, "lateral_accel_m_s2", "roll_deg", lab});
+    sk.push_back({csv, "lateral_accel_m_s2", "understeer_gradient_deg_per_m_s2", lab});
+    hd.push_back({csv, "delta_minus_l_over_R_deg", "lateral_accel_m_s2", lab});
+  }
+  if (plots) {
+    const std::string t = fileTag(vehicle);
+    study::plot({{out + "/iso4138_" + t + "_steer.png", "ISO 4138 " + vehicle + ": front steering angle", "a_y (m/s^2)",
+                  "delta_f (deg)", sd, false, false, false, true},
+                 {out + "/iso4138_" + t + "_side_slip.png", "ISO 4138 " + vehicle + ": side slip", "a_y (m/s^2)",
+                  "beta (deg)", sb, false, false, false, true},
+                 {out + "/iso4138_" + t + "_roll.png", "ISO 4138 " + vehicle + ": roll angle", "a_y (m/s^2)",
+                  "roll (deg)", sr, false, false, false, true},
+                 {out + "/iso4138_" + t + "_understeer.png", "ISO 4138 " + vehicle + ": understeer gradient",
+                  "a_y (m/s^2)", "d delta_f / d a_y (deg/(m/s^2))", sk, false, false, false, true},
+                 {out + "/iso4138_" + t + "_handling_diagram.png", "handling diagram " + vehicle,
+                  "delta_f - l/R (deg)", "a_y (m/s^2)", hd, false, false, false, true}});
+  }
+  return j;
+}
+
+Json iso7401(const Config& c, const std::string& vehicle, const std::string& out, bool plots, bool check) {
+  const ParamReader p = c.data.child("iso7401");
+  auto b = build(c, vehicle);
+  const StepSteerSettings set = StepSteerSettings::fromParams(p);
+  const StepSteerResult st = runStepSteer(b->vehicle, set);
+  const std::string t = fileTag(vehicle);
+  const std::string stepCsv = out + "/iso7401_step_" + t + ".csv";
+  st.history.writeCsv(stepCsv);
+  const FrequencyResponseResult fr = calcSteeringFrequencyResponse(
+      b->vehicle, set.speed_m_s,
+      logFrequencies(p.number("frequency_from_Hz"), p.number("frequency_to_Hz"), p.integer("frequency_count")));
+  const std::string frCsv = out + "/iso7401_frequency_" + t + ".csv";
+  {
+    std::ofstream f(frCsv);
+    f.precision(10);
+    f << "frequency_Hz,yaw_gain_1_per_s,yaw_phase_deg,ay_gain_m_s2_per_rad,ay_phase_deg\n";
+    for (const auto& q : fr.points)
+      f << q.frequency_Hz << ',' << q.yaw_gain_1_per_s << ',' << q.yaw_phase_deg << ',' << q.ay_gain_m_s2_per_rad
+        << ',' << q.ay_phase_deg << '\n';
+  }
+  Json j = {{"speed_m_s", set.speed_m_s},
+            {"front_deg", st.front_rad / kDeg},
+            {"rear_deg", st.rear_rad / kDeg},
+            {"steady_yaw_rate_rad_s", st.steady_yaw_rate_rad_s},
+            {"steady_lateral_accel_m_s2", st.steady_lateral_accel_m_s2},
+            {"yaw_rate_gain_1_per_s", st.yaw_rate_gain_1_per_s},
+            {"yaw_response_time_s", st.yaw_response_time_s},
+            {"yaw_peak_response_time_s", st.yaw_peak_response_time_s},
+            {"yaw_overshoot", st.yaw_overshoot},
+            {"lateral_accel_response_time_s", st.lateral_accel_response_time_s},
+            {"lateral_accel_peak_response_time_s", st.lateral_accel_peak_response_time_s},
+            {"lateral_accel_overshoot", st.lateral_accel_overshoot},
+            {"final_yaw_rate_rel_diff", std::abs(st.final_yaw_rate_rad_s / st.steady_yaw_rate_rad_s - 1)},
+            {"step_steps", st.run.steps},
+            {"frequency_response_dimension", fr.dimension},
+            {"frequency_response_wall_time_s", fr.wall_time_s},
+            {"linear_yaw_gain_zero_1_per_s", fr.yaw_gain_zero_1_per_s},
+            {"step_csv", stepCsv},
+            {"frequency_csv", frCsv}};
+  // Yaw gain -3 dB bandwidth proxy: the frequency of the largest yaw gain.
+  double fPeak = 0, gPeak = 0;
+  for (const auto& q : fr.points)
+    if (q.yaw_gain_1_per_s > gPeak) gPeak = q.yaw_gain_1_per_s, fPeak = q.frequency_Hz;
+  j["yaw_gain_peak_frequency_Hz"] = fPeak;
+  j["yaw_gain_peak_over_steady"] = gPeak / fr.yaw_gain_zero_1_per_s;
+  auto frAt = [&](double f) {
+    for (const auto& q : fr.points)
+      if (std::abs(q.frequency_Hz - f) < 1e-9) return q;
+    return calcSteeringFrequencyResponse(b->vehicle, set.speed_m_s, {f}).points.at(0);
+  };
+  const FrequencyResponsePoint at1 = frAt(1.0);
+  j["yaw_phase_at_1Hz_deg"] = at1.yaw_phase_deg;
+  j["ay_phase_at_1Hz_deg"] = at1.ay_phase_deg;
+  std::printf("  ISO 7401 %-14s step to %.2f deg: r/delta %.4f 1/s, response time %.4f s, peak time %.4f s, overshoot "
+              "%.2f %%; a_y response %.4f s; FR: yaw phase at 1 Hz %.2f deg, a_y phase %.2f deg, peak gain x%.3f at "
+              "%.2f Hz\n",
+              vehicle.c_str(), st.front_rad / kDeg, st.yaw_rate_gain_1_per_s, st.yaw_response_time_s,
+              st.yaw_peak_response_time_s, 100 * st.yaw_overshoot, st.lateral_accel_response_time_s,
+              at1.yaw_phase_deg, at1.ay_phase_deg, gPeak / fr.yaw_gain_zero_1_per_s, fPeak);
+  if (check) {
+    Json cj = Json::array();
+    IntegratorSettings integ = set.integrator;
+    for (double f : p.numbers("check_frequencies_Hz")) {
+      const SineSteerResult s = runSineSteer(b->vehicle, set.speed_m_s, f, p.number("check_amplitude_rad"), integ);
+      const FrequencyResponsePoint l = calcSteeringFrequencyResponse(b->vehicle, set.speed_m_s, {f}).points.at(0);
+      auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
+      cj.push_back({{"frequency_Hz", f},
+                    {"sim_yaw_gain", s.yaw_gain_1_per_s},
+                    {"lin_yaw_gain", l.yaw_gain_1_per_s},
+                    {"sim_yaw_phase_deg", s.yaw_phase_deg},
+                    {"lin_yaw_phase_deg", l.yaw_phase_deg},
+                    {"sim_ay_gain", s.ay_gain_m_s2_per_rad},
+                    {"lin_ay_gain", l.ay_gain_m_s2_per_rad},
+                    {"sim_ay_phase_deg", s.ay_phase_deg},
+                    {"lin_ay_phase_deg", l.ay_phase_deg},
+                    {"yaw_gain_rel_diff", rel(s.yaw_gain_1_per_s, l.yaw_gain_1_per_s)},
+                    {"ay_gain_rel_diff", rel(s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad)},
+                    {"sim_wall_time_s", s.run.wall_time_s}});
+      std::printf("    sine %.2f Hz: yaw gain sim %.5f lin %.5f (%.2e), phase sim %.3f lin %.3f deg; a_y gain sim %.4f lin "
+                  "%.4f (%.2e), phase sim %.3f lin %.3f deg\n",
+                  f, s.yaw_gain_1_per_s, l.yaw_gain_1_per_s, rel(s.yaw_gain_1_per_s, l.yaw_gain_1_per_s), s.yaw_phase_deg,
+                  l.yaw_phase_deg, s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad,
+                  rel(s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad), s.ay_phase_deg, l.ay_phase_deg);
+    }
+    j["sine_check"] = cj;
+  }
+  if (plots) {
+    study::plot({{out + "/iso7401_step_" + t + ".png", "ISO 7401 step steer " + vehicle, "t (s)", "yaw rate (rad/s)",
+                  {{stepCsv, "t_s", "yaw_rate_rad_s", "yaw rate"}}},
+                 {out + "/iso7401_step_ay_" + t + ".png", "ISO 7401 step steer " + vehicle, "t (s)", "a_y (m/s^2)",
+                  {{stepCsv, "t_s", "lateral_accel_m_s2", "lateral acceleration"}}},
+                 {out + "/iso7401_gain_" + t + ".png", "ISO 7401 frequency response " + vehicle + " (gain / gain at 0.1 Hz)",
+                  "f (Hz)", "gain", {{frCsv, "frequency_Hz", "yaw_gain_1_per_s", "yaw rate (1/s)"}}, false, true, false, true},
+                 {out + "/iso7401_phase_" + t + ".png", "ISO 7401 frequency response " + vehicle, "f (Hz)", "phase (deg)",
+                  {{frCsv, "frequency_Hz", "yaw_phase_deg", "yaw rate"}, {frCsv, "frequency_Hz", "ay_phase_deg", "a_y"}},
+                  false, true, false, true}});
+  }
+  return j;
+}
+
+Json sineWithDwell(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
+  auto b = build(c, vehicle);
+  const SineWithDwellSettings set = SineWithDwellSettings::fromParams(c.data.child("sine_with_dwell"));
+  const SineWithDwellResult r = runSineWithDwell(b->vehicle, set);
+  const std::string t = fileTag(vehicle);
+  Json runs = Json::array();
+  std::vector<study::Series> ser;
+  double worst1 = 0, worst175 = 0, minDisp = 1e300;
+  int failedRuns = 0;
+  for (const auto& run : r.runs) {
+    Json jr = {{"factor", run.factor}, {"amplitude_deg", run.amplitude_rad / kDeg}, {"completed", run.completed},
+               {"pass", run.pass}};
+    if (run.completed) {
+      const std::string csv = out + "/swd_" + t + "_" + formatValue(run.factor) + "A.csv";
+      run.history.writeCsv(csv);
+      ser.push_back({csv, "t_s", "yaw_rate_rad_s", formatValue(run.factor) + " A"});
+      jr["peak_yaw_rate_rad_s"] = run.peak_yaw_rate_rad_s;
+      jr["yaw_ratio_1s"] = run.yaw_ratio_1s;
+      jr["yaw_ratio_1_75s"] = run.yaw_ratio_175;
+      jr["lateral_displacement_m"] = run.lateral_displacement_m;
+      worst1 = std::max(worst1, run.yaw_ratio_1s);
+      worst175 = std::max(worst175, run.yaw_ratio_175);
+      if (run.factor >= set.displacement_from_factor - 1e-9) minDisp = std::min(minDisp, run.lateral_displacement_m);
+    } else {
+      jr["reason"] = run.reason;
+      ++failedRuns;
+    }
+    runs.push_back(jr);
+  }
+  std::printf("  SWD      %-14s A %.3f deg, %zu runs (%d spun/failed): max ratio 1.0 s %.3f, 1.75 s %.3f, min "
+              "displacement (>= 5A) %.3f m -> %s\n",
+              vehicle.c_str(), r.angle_A_rad / kDeg, r.runs.size(), failedRuns, worst1, worst175,
+              minDisp < 1e300 ? minDisp : std::nan(""), r.pass ? "PASS" : "FAIL");
+  if (plots && !ser.empty())
+    study::plot({{out + "/swd_" + t + ".png", "sine with dwell " + vehicle, "t (s)", "yaw rate (rad/s)", ser}});
+  return {{"angle_A_deg", r.angle_A_rad / kDeg}, {"runs", runs}, {"pass", r.pass},
+          {"max_yaw_ratio_1s", worst1},      {"max_yaw_ratio_1_75s", worst175},
+          {"min_lateral_displacement_m", minDisp < 1e300 ? Json(minDisp) : Json(nullptr)}, {"failed_runs", failedRuns}};
+}
+}  // namespace
+
+int main(int argc, char** argv) {
+  return study::run("handling", [&] {
+    namespace po = study::po;
+    po::options_description opts("Options");
+    opts.add_options()("data", po::value<std::string>()->default_value("handling.json"), "study data file")(
+        "test", po::value<std::string>()->default_value("iso4138,iso7401,swd"),
+        "comma-separated tests: iso4138, iso7401, swd")(
+        "vehicle", po::value<std::string>()->default_value("4ws/2ws,4ws/linear,4ws/nonlinear,bicycle"),
+        "comma-separated vehicles: 4ws/2ws, 4ws/linear, 4ws/nonlinear, bicycle")(
+        "check", "ISO 7401: cross-check the frequency response with sine-steer simulations")(
+        "no-plots", "skip the PNG plots");
+    const auto vm = study::parse("handling", "standard handling tests (ISO 4138, ISO 7401, sine with dwell)", argc,
+                                 argv, opts);
+    Config c{ParamReader::fromFile(vm["data"].as<std::string>()), {}, {}, {}, {}, 0};
+    c.fourws = FourWsParams::fromFile(c.data.string("vehicle_data"));
+    c.bicycle = BicycleParams::fromFile(c.data.string("bicycle_data"));
+    c.linear = LinearBicycleParams::fromParams(c.data.child("linear_bicycle"));
+    c.table = KrTable::fromFile(c.data.string("kr_table"));
+    c.tire_width_m = c.data.number("tire_width_m");
+    const auto tests = splitList(vm["test"].as<std::string>());
+    const auto vehicles = splitList(vm["vehicle"].as<std::string>());
+    for (const auto& t : tests)
+      if (t != "iso4138" && t != "iso7401" && t != "swd")
+        throw Error("--test: unknown test '" + t + "'; known: iso4138, iso7401, swd");
+    for (const auto& v : vehicles)
+      if (v != "bicycle" && v != "4ws/2ws" && v != "4ws/linear" && v != "4ws/nonlinear")
+        throw Error("--vehicle: unknown vehicle '" + v + "'; known: 4ws/2ws, 4ws/linear, 4ws/nonlinear, bicycle");
+    const std::string out = study::outputDir(vm, "handling");
+    const bool plots = !vm.count("no-plots");
+    Json summary = Json::object();
+    for (const auto& v : vehicles) {
+      Json jv = Json::object();
+      for (const auto& t : tests) {
+        if (t == "iso4138") jv["iso4138"] = iso4138(c, v, out, plots);
+        if (t == "iso7401") jv["iso7401"] = iso7401(c, v, out, plots, vm.count("check") > 0);
+        if (t == "swd") jv["sine_with_dwell"] = sineWithDwell(c, v, out, plots);
+      }
+      summary[v] = jv;
+    }
+    // 2WS / 4WS ranking on the 4WS vehicle (strategies run): one row per strategy.
+    std::printf("\n  %-14s %10s %10s %10s %10s %10s %10s %8s\n", "vehicle", "ay_lim100", "K0_deg", "t_r90_s",
+                "overshoot", "r_gain", "swd_r1", "swd");
+    for (const auto& v : vehicles) {
+      const Json& jv = summary[v];
+      auto num = [](const Json& j, const char* k) { return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan(""); };
+      const double ay = jv.contains("iso4138") ? num(jv["iso4138"][0], "limit_lateral_accel_m_s2") : std::nan("");
+      const double k0 = jv.contains("iso4138") ? num(jv["iso4138"][0], "understeer_gradient_linear_deg_per_m_s2") : std::nan("");
+      const double tr = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_response_time_s") : std::nan("");
+      const double os = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_overshoot") : std::nan("");
+      const double rg = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_rate_gain_1_per_s") : std::nan("");
+      const double r1 = jv.contains("sine_with_dwell") ? num(jv["sine_with_dwell"], "max_yaw_ratio_1s") : std::nan("");
+      const std::string swd = jv.contains("sine_with_dwell") ? (jv["sine_with_dwell"]["pass"].get<bool>() ? "pass" : "FAIL") : "-";
+      std::printf("  %-14s %10.3f %+10.4f %10.4f %10.4f %10.4f %10.4f %8s\n", v.c_str(), ay, k0, tr, os, rg, r1,
+                  swd.c_str());
+    }
+    study::writeJson(out + "/summary.json", summary);
+  });
+}

@@ -1,0 +1,73 @@
+// Handling tests (plugins/handling): ISO 4138 constant radius against the
+// linear bicycle's closed form and a long transient; ISO 7401 frequency
+// response against sine-steer simulations.
+#include <cmath>
+#include <cstdio>
+
+#include <gtest/gtest.h>
+
+#include "test_util.h"
+#include "vdyn/handling/iso4138.h"
+#include "vdyn/vehicles/handling_vehicles.h"
+
+using namespace vdyn;
+
+namespace {
+const double kDeg = SimTK::Pi / 180;
+
+std::unique_ptr<HandlingBuild> bike(const std::string& tire) {
+  BicycleParams p = BicycleParams::fromFile("bicycle.json");
+  p.tire_plugin = tire;
+  return makeHandlingBicycle(p);
+}
+}  // namespace
+
+TEST(Iso4138, LinearTireBicycleUndersteerGradientIsTheClosedForm) {
+  auto b = bike("linear");
+  const Bicycle& bk = *b->bicycle;
+  ConstantRadiusSettings set;
+  set.radius_m = 100;
+  set.speed_start_m_s = 3;
+  set.speed_step_m_s = 1;
+  set.speed_max_m_s = 8;  // a_y <= 0.64 m/s^2: the linear range
+  set.stability = false;
+  const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
+  // Linear bicycle (6.1)-(6.9), two tires per axle: delta_f = l / R + K a_y,
+  // K = M / l (b / C_f - a / C_r).
+  const double M = bk.totalMass(), a = bk.distanceToFrontAxle(), bb = bk.distanceToRearAxle(), l = a + bb;
+  const double C = 2 * bk.params().tire.cornering_stiffness_N_per_rad;
+  const double K = M / l * (bb / C - a / C);
+  std::printf("understeer gradient %.6e rad/(m/s^2) (closed form %.6e), delta at a_y = %.3f: %.6e (l/R + K a_y = %.6e)\n",
+              r.understeer_gradient_linear_rad_per_m_s2, K, r.points[0].lateral_accel_m_s2, r.points[0].front_rad,
+              l / 100 + K * r.points[0].lateral_accel_m_s2);
+  EXPECT_EQ(r.points.size(), 6u);
+  EXPECT_FALSE(r.limit_found);
+  EXPECT_NEAR(r.understeer_gradient_linear_rad_per_m_s2, K, 1e-3 * std::abs(K));
+  // The path radius is the one asked for: U / r = R.
+  for (const auto& p : r.points) EXPECT_NEAR(p.path_radius_m, 100.0, 1e-8);
+}
+
+TEST(Iso4138, LongTransientEndsOnTheConstantRadiusSteadyState) {
+  auto b = bike("gim");
+  ConstantRadiusSettings set;
+  set.radius_m = 40;
+  set.speed_start_m_s = set.speed_max_m_s = 12;  // a_y = 3.6 m/s^2
+  set.stability = false;
+  const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
+  ASSERT_EQ(r.points.size(), 1u);
+  const ConstantRadiusPoint& p = r.points[0];
+  // The transient from straight running with the solved angle held.
+  b->vehicle.holdSteering(12, p.front_rad);
+  IntegratorSettings integ;
+  integ.accuracy = 1e-8;
+  const HandlingHistory h = runHandlingTransient(b->vehicle, 12, 15.0, 0.5, integ);
+  const double rT = h.yaw_rate_rad_s.back(), ayT = h.lateral_accel_m_s2.back();
+  std::printf("front %.6f deg: yaw rate steady %.9f transient %.9f; a_y %.9f / %.9f; side slip %.9f / %.9f; roll %.9g / %.9g\n",
+              p.front_rad / kDeg, p.yaw_rate_rad_s, rT, p.lateral_accel_m_s2, ayT, p.side_slip_rad,
+              h.side_slip_rad.back(), p.roll_rad, h.roll_rad.back());
+  EXPECT_NEAR(rT, p.yaw_rate_rad_s, 1e-5 * p.yaw_rate_rad_s);
+  EXPECT_NEAR(ayT, p.lateral_accel_m_s2, 1e-5 * p.lateral_accel_m_s2);
+  EXPECT_NEAR(h.side_slip_rad.back(), p.side_slip_rad, 1e-5 * std::abs(p.side_slip_rad));
+  // Path radius of the transient: U / r.
+  EXPECT_NEAR(12.0 / rT, 40.0, 40.0 * 1e-5);
+}
