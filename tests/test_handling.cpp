@@ -8,6 +8,7 @@
 
 #include "test_util.h"
 #include "vdyn/handling/iso4138.h"
+#include "vdyn/handling/iso7401.h"
 #include "vdyn/vehicles/handling_vehicles.h"
 
 using namespace vdyn;
@@ -70,4 +71,30 @@ TEST(Iso4138, LongTransientEndsOnTheConstantRadiusSteadyState) {
   EXPECT_NEAR(h.side_slip_rad.back(), p.side_slip_rad, 1e-5 * std::abs(p.side_slip_rad));
   // Path radius of the transient: U / r.
   EXPECT_NEAR(12.0 / rT, 40.0, 40.0 * 1e-5);
+}
+
+TEST(Iso7401, FrequencyResponseMatchesSineSteerSimulations) {
+  // Linear tires: the Gim tire's lateral force has a |alpha| kink at zero slip
+  // (straight running), so its sine response deviates from the tangent
+  // linearisation in proportion to the amplitude (0.4 deg of phase at 0.002 rad).
+  auto b = bike(std::getenv("VDYN_TIRE") ? std::getenv("VDYN_TIRE") : "linear");
+  const double U = 80.0 / 3.6;
+  const std::vector<double> freqs = {0.5, 1.0, 2.0};
+  const FrequencyResponseResult fr = calcSteeringFrequencyResponse(b->vehicle, U, freqs);
+  IntegratorSettings integ;
+  integ.accuracy = 1e-8;
+  for (std::size_t i = 0; i < freqs.size(); ++i) {
+    const double settle = std::getenv("VDYN_SETTLE") ? std::atof(std::getenv("VDYN_SETTLE")) : 2.0;
+    const double amp = std::getenv("VDYN_AMP") ? std::atof(std::getenv("VDYN_AMP")) : 0.002;
+    const SineSteerResult s = runSineSteer(b->vehicle, U, freqs[i], amp, integ, 1, settle, 2);
+    const FrequencyResponsePoint& l = fr.points[i];
+    std::printf("%.2f Hz: yaw gain sim %.6f lin %.6f, phase sim %.4f lin %.4f deg; a_y gain sim %.5f lin %.5f, phase "
+                "sim %.4f lin %.4f deg (fit residual %.1e)\n",
+                freqs[i], s.yaw_gain_1_per_s, l.yaw_gain_1_per_s, s.yaw_phase_deg, l.yaw_phase_deg,
+                s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad, s.ay_phase_deg, l.ay_phase_deg, s.fit_residual);
+    EXPECT_NEAR(s.yaw_gain_1_per_s, l.yaw_gain_1_per_s, 0.01 * l.yaw_gain_1_per_s);
+    EXPECT_NEAR(s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad, 0.01 * l.ay_gain_m_s2_per_rad);
+    EXPECT_NEAR(s.yaw_phase_deg, l.yaw_phase_deg, 0.01 * std::abs(l.yaw_phase_deg));
+    EXPECT_NEAR(s.ay_phase_deg, l.ay_phase_deg, 0.01 * std::abs(l.ay_phase_deg));
+  }
 }
