@@ -9,6 +9,7 @@
 #include "test_util.h"
 #include "vdyn/handling/iso4138.h"
 #include "vdyn/handling/iso7401.h"
+#include "vdyn/steady_state/steady_state.h"
 #include "vdyn/vehicles/handling_vehicles.h"
 
 using namespace vdyn;
@@ -96,5 +97,25 @@ TEST(Iso7401, FrequencyResponseMatchesSineSteerSimulations) {
     EXPECT_NEAR(s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad, 0.01 * l.ay_gain_m_s2_per_rad);
     EXPECT_NEAR(s.yaw_phase_deg, l.yaw_phase_deg, 0.01 * std::abs(l.yaw_phase_deg));
     EXPECT_NEAR(s.ay_phase_deg, l.ay_phase_deg, 0.01 * std::abs(l.ay_phase_deg));
+  }
+}
+
+TEST(VehicleReport, StaticLoadsBalanceTheWeightAndKinematicsAreConsistent) {
+  const VehicleReport r = makeFourWsReport(FourWsParams::fromFile("appendix_a.json"), {-0.08, 0.0, 0.08});
+  std::printf("4ws: loads %.2f %.2f %.2f %.2f N (sum %.3f, weight %.3f), c.m. height %.4f m, %d iterations\n",
+              r.corner_loads_N[0].second, r.corner_loads_N[1].second, r.corner_loads_N[2].second,
+              r.corner_loads_N[3].second, r.total_load_N, r.weight_N, r.com_height_m, r.iterations);
+  // The tires carry the weight (the steady-state solver at zero speed is a static equilibrium).
+  EXPECT_NEAR(r.total_load_N, r.weight_N, 1e-6 * r.weight_N);
+  // Left and right corners mirror each other.
+  EXPECT_NEAR(r.corner_loads_N[0].second, r.corner_loads_N[1].second, 1e-6 * r.corner_loads_N[0].second);
+  for (const auto& [axle, pts] : r.kinematics) {
+    ASSERT_EQ(pts.size(), 3u);
+    EXPECT_NEAR(pts[1].track_change_m, 0.0, 1e-12) << axle;
+    EXPECT_NEAR(pts[1].recession_m, 0.0, 1e-12) << axle;
+    EXPECT_GT(pts[1].wheel_rate_N_per_m, 0.0) << axle;
+    std::printf("%s: camber %.4f/%.4f/%.4f deg, track %.5f/%.5f m, rate %.0f N/m, roll centre %.4f m\n", axle.c_str(),
+                pts[0].camber_rad / kDeg, pts[1].camber_rad / kDeg, pts[2].camber_rad / kDeg, pts[0].track_change_m,
+                pts[2].track_change_m, pts[1].wheel_rate_N_per_m, pts[1].roll_centre_height_m);
   }
 }

@@ -70,4 +70,80 @@ std::unique_ptr<HandlingBuild> makeHandlingBicycle(const BicycleParams& params, 
   return b;
 }
 
+namespace {
+SuspensionCorner cornerOf(const Scene& sc, const std::string& name, const DoubleWishboneCorner& c) {
+  SuspensionCorner k;
+  k.name = name;
+  k.lower_arm = c.lower_arm;
+  k.knuckle = c.knuckle;
+  k.wheel = c.wheel;
+  k.free = {c.knuckle.getMobilizedBodyIndex(), c.upper_arm.getMobilizedBodyIndex()};
+  k.spring = c.spring;
+  (void)sc;
+  return k;
+}
+}  // namespace
+
+VehicleReport makeFourWsReport(const FourWsParams& params, const std::vector<double>& travels) {
+  FourWsVehicle car(params);
+  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.0));
+  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.0));
+  const Scene& sc = car.getScene();
+  // Static equilibrium: the steady-state equations at zero speed (no speed
+  // hold): the chassis x, y, yaw and wheel spin angles are ineffective, the
+  // speeds are unknowns that solve to zero.
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0));
+  const SteadyStateResult r = solver.solve(car.makeInitialState(0.0));
+  SimTK::State s = r.state;
+  sc.getSystem().realize(s, SimTK::Stage::Velocity);
+  VehicleReport rep;
+  rep.vehicle = "4ws";
+  rep.method = "steady-state solver at zero speed (plugins/steady_state)";
+  rep.iterations = r.iterations;
+  rep.force_residual_N = r.force_residual;
+  const double road = makeRoad(params.road)->height(0, 0, 0);
+  for (int c = 0; c < 4; ++c) {
+    const double fz = sc.evalOutput(std::string("tire_") + cornerName(c) + ".Fz_N", s);
+    rep.corner_loads_N.push_back({cornerName(c), fz});
+    (c < 2 ? rep.front_axle_load_N : rep.rear_axle_load_N) += fz;
+    rep.total_load_N += fz;
+  }
+  rep.weight_N = car.totalMass() * params.gravity_m_per_s2;
+  rep.chassis_origin_height_m = car.chassis().getBodyOriginLocation(s)[2] - road;
+  rep.com_height_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[2] - road;
+  const double y0 = car.chassis().getBodyOriginLocation(s)[1];
+  for (int c : {RF, RR}) {
+    SuspensionCorner k = cornerOf(sc, cornerName(c), car.corner(c));
+    k.centre_plane_y_m = y0;
+    rep.kinematics.push_back({c == RF ? "front" : "rear", calcSuspensionKinematics(sc, s, k, travels, road)});
+  }
+  return rep;
+}
+
+VehicleReport makeQuarterCarReport(const QuarterCarParams& params, const std::vector<double>& travels) {
+  QuarterCar car(params);
+  const Scene& sc = car.getScene();
+  SimTK::State s = car.makeInitialState(true);
+  sc.getSystem().realize(s, SimTK::Stage::Velocity);
+  VehicleReport rep;
+  rep.vehicle = "quarter_car";
+  rep.method = "solveStaticEquilibrium (core)";
+  const std::string fzName = [&] {
+    for (const auto& n : sc.getOutputNames())
+      if (n.size() > 5 && n.substr(n.size() - 5) == ".Fz_N") return n;
+    throw Error("quarter car: no tire Fz output");
+  }();
+  const double fz = sc.evalOutput(fzName, s);
+  rep.corner_loads_N.push_back({"corner", fz});
+  rep.total_load_N = fz;
+  rep.weight_N = car.totalMass() * params.gravity_m_per_s2;
+  const double road = makeRoad(params.road)->height(0, 0, 0);
+  rep.chassis_origin_height_m = car.chassis().getBodyOriginLocation(s)[2] - road;
+  rep.com_height_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[2] - road;
+  SuspensionCorner k = cornerOf(sc, "corner", car.corner());
+  k.centre_plane_y_m = car.chassis().getBodyOriginLocation(s)[1];
+  rep.kinematics.push_back({"corner", calcSuspensionKinematics(sc, s, k, travels, road)});
+  return rep;
+}
+
 }  // namespace vdyn

@@ -9,7 +9,8 @@
 // peak after the steering changes sign, and the lateral displacement of the
 // chassis origin 1.07 s after the beginning of steer (BOS), against the
 // regulation's limits: <= 35 %, <= 20 %, >= 1.83 m (GVWR <= 3500 kg; required
-// from 5 A). Deviation: the speed is held (3.18) instead of coasting.
+// from 5 A). Deviations: the speed is held (3.18) instead of coasting; the
+// sine is blended in and out over blend_s (50 ms) so the command is C1.
 #include <string>
 #include <vector>
 
@@ -37,6 +38,10 @@ struct SineWithDwellSettings {
   double displacement_limit_m = 1.83;       ///< at 1.07 s after BOS, m
   double displacement_from_factor = 5.0;    ///< the displacement limit applies from this amplitude / A
   double sample_s = 0.002;
+  /// The command's rate jumps at the beginning and the completion of steer
+  /// (A w): a velocity-level step no integrator passes. The sine is blended
+  /// in and out by smooth steps 3 u^2 - 2 u^3 over blend_s, s.
+  double blend_s = 0.05;
   IntegratorSettings integrator;
   SineWithDwellSettings() { integrator.accuracy = 1e-6; }
   void validate() const;
