@@ -70,7 +70,7 @@ int main(int argc, char** argv) {
     const ConstantRadiusResult rs = runConstantRadius(v, set);
     // The points on the 1 m/s grid (bisection points of the limit left out).
     std::vector<ConstantRadiusPoint> grid;
-    for (const auto& p : r.points)
+    for (const auto& p : rs.points)
       if (std::abs(p.speed_m_s - std::round(p.speed_m_s)) < 1e-9) grid.push_back(p);
     std::printf("iso4138_cost: R = %g m, %zu grid speeds (%zu solves incl. the limit's bisection), limit a_y %.4f m/s^2\n",
                 set.radius_m, grid.size(), r.points.size(), r.limit_lateral_accel_m_s2);
@@ -89,12 +89,13 @@ int main(int argc, char** argv) {
       simTotal += run.wall_time_s;
       steps += run.steps;
       const double rel = std::abs(h.yaw_rate_rad_s.back() / p.yaw_rate_rad_s - 1);
-      worst = std::max(worst, rel);
-      std::printf("    U %5.1f m/s a_y %6.3f m/s^2 delta_f %7.4f deg: transient %.3f s wall, %d steps, yaw rate rel diff %.2e\n",
-                  U, p.lateral_accel_m_s2, D * 180 / SimTK::Pi, run.wall_time_s, run.steps, rel);
+      if (p.stable) worst = std::max(worst, rel);
+      std::printf("    U %5.1f m/s a_y %6.3f m/s^2 delta_f %7.4f deg %s: transient %.3f s wall, %d steps, yaw rate rel diff %.2e\n",
+                  U, p.lateral_accel_m_s2, D * 180 / SimTK::Pi, p.stable ? "stable  " : "UNSTABLE", run.wall_time_s,
+                  run.steps, rel);
     }
     const double ratio = sweep / simTotal;
-    std::printf("  simulations: %zu x %g s at %g: %.3f s wall, %d steps; largest yaw-rate rel diff at t_end %.2e\n",
+    std::printf("  simulations: %zu x %g s at %g: %.3f s wall, %d steps; largest yaw-rate rel diff at t_end (stable points; unstable ones diverge) %.2e\n",
                 grid.size(), tEnd, integ.accuracy, simTotal, steps, worst);
     std::printf("  ratio sweep / simulations: %.5f (%.3f %%); with stability %.5f\n", ratio, 100 * ratio,
                 rs.wall_time_s / simTotal);

@@ -51,6 +51,10 @@ struct VehicleReport {
 /// zero speed (unknowns q, u, lambda; the speeds solve to zero), kinematics of
 /// the RF and RR corners over `travels_m`.
 VehicleReport makeFourWsReport(const FourWsParams& params, const std::vector<double>& travels_m);
+/// Registers the analyses iso4138_constant_radius, iso7401, sine_with_dwell
+/// and vehicle_report (scene files; vehicles/handling/handling_analyses.cpp).
+void registerHandlingAnalyses(PluginRegistry& registry);
+
 /// The quarter car's report: static equilibrium by solveStaticEquilibrium
 /// (QuarterCar::makeInitialState), kinematics of its corner.
 VehicleReport makeQuarterCarReport(const QuarterCarParams& params, const std::vector<double>& travels_m);

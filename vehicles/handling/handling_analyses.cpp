@@ -1,0 +1,294 @@
+// The handling tests as analyses a scene file names ("analysis": {"type":
+// "iso4138_constant_radius" | "iso7401" | "sine_with_dwell" | "vehicle_report"}).
+// Each rebuilds the scene's vehicle (type and data file with its overrides)
+// prepared for the tests (handling_vehicles.h): programmable steering, speed
+// hold and the rear-steer strategy named in the settings. Plugins listed in the
+// scene are not used by these analyses (the test defines the steering).
+#include <algorithm>
+#include <cmath>
+
+#include "vdyn/core/scene_file.h"
+#include "vdyn/handling/iso4138.h"
+#include "vdyn/handling/iso7401.h"
+#include "vdyn/handling/sine_with_dwell.h"
+#include "vdyn/vehicles/handling_vehicles.h"
+
+namespace vdyn {
+
+namespace {
+const double kDeg = SimTK::Pi / 180;
+
+/// Keys every handling analysis takes besides its test's own.
+struct VehicleChoice {
+  std::string rear_strategy = "2ws";
+  std::string kr_table = "kr_table.json";
+  LinearBicycleParams linear;
+  double tire_width_m = 0.195;
+  bool has_linear = false;
+  static VehicleChoice fromParams(const ParamReader& r) {
+    VehicleChoice c;
+    c.rear_strategy = r.stringOr("rear_strategy", c.rear_strategy);
+    c.kr_table = r.stringOr("kr_table", c.kr_table);
+    c.tire_width_m = r.numberOr("tire_width_m", c.tire_width_m);
+    if (r.has("linear_bicycle")) c.linear = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
+    const auto& names = rearSteerStrategyNames();
+    if (std::find(names.begin(), names.end(), c.rear_strategy) == names.end())
+      throw Error(r.at("rear_strategy") + ": unknown rear steer strategy '" + c.rear_strategy + "'; known: 2ws, linear, nonlinear");
+    return c;
+  }
+};
+const std::vector<FieldInfo> kVehicleKeys = {
+    {"rear_strategy", "-", "\"2ws\"", "4WS rear steer: 2ws, linear (Kr(U) of linear_bicycle), nonlinear (kr_table)"},
+    {"kr_table", "-", "\"kr_table.json\"", "coefficient table of the nonlinear strategy"},
+    {"linear_bicycle", "-", "chapter 6 values", "linear bicycle of the linear strategy (mass_kg, ...)"},
+    {"tire_width_m", "m", "0.195", "tire section width (vehicle width = track + this)"}};
+
+ParamReader vehicleData(const SceneDescription& d) {
+  const Json& v = d.json().at("vehicle");
+  Json data = ParamReader::fromFile(d.resolve(v.at("data").get<std::string>())).json();
+  if (v.contains("overrides")) data.merge_patch(v.at("overrides"));
+  return ParamReader::fromJson(std::move(data), v.at("data").get<std::string>());
+}
+
+std::string vehicleType(const SceneDescription& d) { return d.json().at("vehicle").at("type").get<std::string>(); }
+
+std::unique_ptr<HandlingBuild> buildHandling(const SceneDescription& d, const VehicleChoice& c) {
+  const std::string type = vehicleType(d);
+  if (type == "bicycle") return makeHandlingBicycle(BicycleParams::fromParams(vehicleData(d)), c.tire_width_m);
+  if (type == "fourws") {
+    KrTable table;
+    const bool needTable = c.rear_strategy == "nonlinear";
+    if (needTable) table = KrTable::fromFile(d.resolve(c.kr_table));
+    return makeHandlingFourWs(FourWsParams::fromParams(vehicleData(d)), c.rear_strategy, c.linear,
+                              needTable ? &table : nullptr, c.tire_width_m);
+  }
+  throw Error("handling tests run on vehicle types fourws and bicycle, not '" + type + "'");
+}
+
+Json nullIfNan(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+class ConstantRadiusAnalysis : public Analysis {
+ public:
+  explicit ConstantRadiusAnalysis(const ParamReader& r)
+      : Analysis("iso4138_constant_radius"), c_(VehicleChoice::fromParams(r)) {
+    s_ = ConstantRadiusSettings::fromParams(r);
+  }
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    auto b = buildHandling(ctx.description, c_);
+    const ConstantRadiusResult r = runConstantRadius(b->vehicle, s_);
+    AnalysisResult res;
+    Table t;
+    t.columns = {"speed_m_s", "lateral_accel_m_s2", "front_deg", "rear_deg", "side_slip_deg", "roll_deg",
+                 "yaw_rate_rad_s", "understeer_gradient_deg_per_m_s2", "delta_minus_l_over_R_deg", "stable",
+                 "least_damped_re_per_s"};
+    for (const auto& p : r.points)
+      t.rows.push_back({p.speed_m_s, p.lateral_accel_m_s2, p.front_rad / kDeg, p.rear_rad / kDeg, p.side_slip_rad / kDeg,
+                        p.roll_rad / kDeg, p.yaw_rate_rad_s, p.understeer_gradient_rad_per_m_s2 / kDeg,
+                        (p.front_rad - r.wheelbase_m / r.radius_m) / kDeg, double(p.stable), p.least_damped.real()});
+    res.tables.push_back({"iso4138", t});
+    res.summary = {{"vehicle", b->vehicle.name},
+                   {"radius_m", r.radius_m},
+                   {"points", r.points.size()},
+                   {"limit_found", r.limit_found},
+                   {"limit_speed_m_s", r.limit_speed_m_s},
+                   {"limit_lateral_accel_m_s2", r.limit_lateral_accel_m_s2},
+                   {"understeer_gradient_linear_deg_per_m_s2", r.understeer_gradient_linear_rad_per_m_s2 / kDeg},
+                   {"stability_lost_speed_m_s", nullIfNan(r.stability_lost_speed_m_s)},
+                   {"stability_lost_lateral_accel_m_s2", nullIfNan(r.stability_lost_lateral_accel_m_s2)},
+                   {"solve_wall_time_s", r.solve_wall_time_s},
+                   {"wall_time_s", r.wall_time_s}};
+    return res;
+  }
+
+ private:
+  VehicleChoice c_;
+  ConstantRadiusSettings s_;
+};
+
+class Iso7401Analysis : public Analysis {
+ public:
+  explicit Iso7401Analysis(const ParamReader& r) : Analysis("iso7401"), c_(VehicleChoice::fromParams(r)) {
+    s_ = StepSteerSettings::fromParams(r);
+    f0_ = r.numberOr("frequency_from_Hz", 0.1);
+    f1_ = r.numberOr("frequency_to_Hz", 4.0);
+    n_ = int(r.numberOr("frequency_count", 25));
+    logFrequencies(f0_, f1_, n_);
+  }
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    auto b = buildHandling(ctx.description, c_);
+    const StepSteerResult st = runStepSteer(b->vehicle, s_);
+    const FrequencyResponseResult fr = calcSteeringFrequencyResponse(b->vehicle, s_.speed_m_s, logFrequencies(f0_, f1_, n_));
+    AnalysisResult res;
+    Table step;
+    step.columns = {"t_s", "front_rad", "rear_rad", "yaw_rate_rad_s", "lateral_accel_m_s2"};
+    const auto& h = st.history;
+    for (std::size_t i = 0; i < h.t_s.size(); ++i)
+      step.rows.push_back({h.t_s[i], h.front_rad[i], h.rear_rad[i], h.yaw_rate_rad_s[i], h.lateral_accel_m_s2[i]});
+    Table f;
+    f.columns = {"frequency_Hz", "yaw_gain_1_per_s", "yaw_phase_deg", "ay_gain_m_s2_per_rad", "ay_phase_deg"};
+    for (const auto& q : fr.points)
+      f.rows.push_back({q.frequency_Hz, q.yaw_gain_1_per_s, q.yaw_phase_deg, q.ay_gain_m_s2_per_rad, q.ay_phase_deg});
+    res.tables.push_back({"step_steer", step});
+    res.tables.push_back({"frequency_response", f});
+    res.summary = {{"vehicle", b->vehicle.name},
+                   {"front_deg", st.front_rad / kDeg},
+                   {"steady_yaw_rate_rad_s", st.steady_yaw_rate_rad_s},
+                   {"yaw_rate_gain_1_per_s", st.yaw_rate_gain_1_per_s},
+                   {"yaw_response_time_s", st.yaw_response_time_s},
+                   {"yaw_peak_response_time_s", st.yaw_peak_response_time_s},
+                   {"yaw_overshoot", st.yaw_overshoot},
+                   {"lateral_accel_response_time_s", st.lateral_accel_response_time_s},
+                   {"lateral_accel_overshoot", st.lateral_accel_overshoot},
+                   {"linear_yaw_gain_zero_1_per_s", fr.yaw_gain_zero_1_per_s},
+                   {"linear_stable", fr.stable}};
+    return res;
+  }
+
+ private:
+  VehicleChoice c_;
+  StepSteerSettings s_;
+  double f0_, f1_;
+  int n_;
+};
+
+class SineWithDwellAnalysis : public Analysis {
+ public:
+  explicit SineWithDwellAnalysis(const ParamReader& r)
+      : Analysis("sine_with_dwell"), c_(VehicleChoice::fromParams(r)), s_(SineWithDwellSettings::fromParams(r)) {}
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    auto b = buildHandling(ctx.description, c_);
+    const SineWithDwellResult r = runSineWithDwell(b->vehicle, s_);
+    AnalysisResult res;
+    Table t;
+    t.columns = {"factor", "amplitude_deg", "completed", "yaw_ratio_1s", "yaw_ratio_1_75s", "lateral_displacement_m", "pass"};
+    Json runs = Json::array();
+    for (const auto& q : r.runs) {
+      t.rows.push_back({q.factor, q.amplitude_rad / kDeg, double(q.completed), q.completed ? q.yaw_ratio_1s : NAN,
+                        q.completed ? q.yaw_ratio_175 : NAN, q.completed ? q.lateral_displacement_m : NAN, double(q.pass)});
+      Json j = {{"factor", q.factor}, {"completed", q.completed}, {"pass", q.pass}};
+      if (!q.completed) j["reason"] = q.reason;
+      runs.push_back(j);
+    }
+    res.tables.push_back({"sine_with_dwell", t});
+    res.summary = {{"vehicle", b->vehicle.name}, {"angle_A_deg", r.angle_A_rad / kDeg}, {"pass", r.pass}, {"runs", runs}};
+    return res;
+  }
+
+ private:
+  VehicleChoice c_;
+  SineWithDwellSettings s_;
+};
+
+class VehicleReportAnalysis : public Analysis {
+ public:
+  explicit VehicleReportAnalysis(const ParamReader& r) : Analysis("vehicle_report") {
+    range_ = r.numberOr("travel_range_m", 0.08);
+    step_ = r.numberOr("travel_step_m", 0.01);
+    requirePositive(range_, r.at("travel_range_m"));
+    requirePositive(step_, r.at("travel_step_m"));
+  }
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    std::vector<double> travels;
+    for (double z = -range_; z <= range_ + 1e-12; z += step_) travels.push_back(std::abs(z) < 1e-12 ? 0.0 : z);
+    const std::string type = vehicleType(ctx.description);
+    VehicleReport rep;
+    if (type == "fourws")
+      rep = makeFourWsReport(FourWsParams::fromParams(vehicleData(ctx.description)), travels);
+    else if (type == "quarter_car")
+      rep = makeQuarterCarReport(QuarterCarParams::fromParams(vehicleData(ctx.description)), travels);
+    else
+      throw Error("vehicle_report runs on vehicle types fourws and quarter_car, not '" + type + "'");
+    AnalysisResult res;
+    Json loads = Json::object();
+    for (const auto& [n, f] : rep.corner_loads_N) loads[n] = f;
+    res.summary = {{"vehicle", rep.vehicle},
+                   {"method", rep.method},
+                   {"iterations", rep.iterations},
+                   {"corner_loads_N", loads},
+                   {"front_axle_load_N", rep.front_axle_load_N},
+                   {"rear_axle_load_N", rep.rear_axle_load_N},
+                   {"total_load_N", rep.total_load_N},
+                   {"weight_N", rep.weight_N},
+                   {"chassis_origin_height_m", rep.chassis_origin_height_m},
+                   {"com_height_m", rep.com_height_m}};
+    for (const auto& [axle, pts] : rep.kinematics) {
+      Table t;
+      t.columns = {"travel_m", "camber_deg", "toe_in_deg", "track_change_m", "recession_m", "wheel_rate_N_per_m",
+                   "roll_centre_height_m"};
+      for (const auto& p : pts)
+        t.rows.push_back({p.travel_m, p.camber_rad / kDeg, p.toe_rad / kDeg, p.track_change_m, p.recession_m,
+                          p.wheel_rate_N_per_m, p.roll_centre_height_m});
+      for (const auto& p : pts)
+        if (p.travel_m == 0.0)
+          res.summary["kinematics_at_rest"][axle] = {{"camber_deg", p.camber_rad / kDeg},
+                                                      {"wheel_rate_N_per_m", p.wheel_rate_N_per_m},
+                                                      {"roll_centre_height_m", p.roll_centre_height_m}};
+      res.tables.push_back({"kinematics_" + axle, t});
+    }
+    return res;
+  }
+
+ private:
+  double range_, step_;
+};
+
+std::vector<FieldInfo> withVehicleKeys(std::vector<FieldInfo> f) {
+  f.insert(f.end(), kVehicleKeys.begin(), kVehicleKeys.end());
+  return f;
+}
+}  // namespace
+
+void registerHandlingAnalyses(PluginRegistry& registry) {
+  registry.addAnalysis(
+      "iso4138_constant_radius", [](const ParamReader& r) { return std::make_unique<ConstantRadiusAnalysis>(r); },
+      {"ISO 4138 steady-state circular driving, constant radius: steady-state solves (steering angle unknown, U = r R) "
+       "continued in speed to the limit; table iso4138.csv",
+       withVehicleKeys({{"radius_m", "m", "100", "path radius of the chassis origin"},
+                        {"speed_start_m_s", "m/s", "4", "first speed"},
+                        {"speed_step_m_s", "m/s", "1", "speed increment"},
+                        {"speed_max_m_s", "m/s", "60", "last speed tried"},
+                        {"limit_tolerance_m_s", "m/s", "0.005", "bisection tolerance of the limit speed"},
+                        {"stability", "-", "true", "eigenvalues at each point"}})});
+  registry.addAnalysis(
+      "iso7401", [](const ParamReader& r) { return std::make_unique<Iso7401Analysis>(r); },
+      {"ISO 7401 step steer (simulation) and frequency response (linearisation about straight running); tables "
+       "step_steer.csv, frequency_response.csv",
+       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "test speed"},
+                        {"lateral_accel_m_s2", "m/s^2", "4", "steady lateral acceleration of the step"},
+                        {"step_start_s", "s", "0.5", "start of the steering ramp"},
+                        {"ramp_time_s", "s", "0.15", "ramp duration (smooth step 7.4)"},
+                        {"duration_s", "s", "4", "simulated time after the ramp starts"},
+                        {"sample_s", "s", "0.002", "sampling interval"},
+                        {"integrator", "-", "rk_merson 1e-6", "integrator settings"},
+                        {"frequency_from_Hz", "Hz", "0.1", "lowest frequency"},
+                        {"frequency_to_Hz", "Hz", "4", "highest frequency"},
+                        {"frequency_count", "", "25", "log-spaced frequencies"}})});
+  registry.addAnalysis(
+      "sine_with_dwell", [](const ParamReader& r) { return std::make_unique<SineWithDwellAnalysis>(r); },
+      {"FMVSS 126 sine with dwell: A at 0.3 g (steady state), 0.7 Hz sine with 500 ms dwell from 1.5 A; yaw-rate "
+       "ratios and lateral displacement against the limits; table sine_with_dwell.csv",
+       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "test speed (held)"},
+                        {"lateral_accel_m_s2", "m/s^2", "2.943", "lateral acceleration defining A"},
+                        {"frequency_Hz", "Hz", "0.7", "sine frequency"},
+                        {"dwell_s", "s", "0.5", "dwell at the second peak"},
+                        {"first_factor", "", "1.5", "first amplitude / A"},
+                        {"factor_step", "", "0.5", "amplitude increment / A"},
+                        {"max_amplitude_factor", "", "6.5", "last amplitude / A"},
+                        {"max_amplitude_rad", "rad", "0.35", "cap on the road-wheel amplitude"},
+                        {"blend_s", "s", "0.05", "smooth blend in/out of the sine"}})});
+  registry.addAnalysis(
+      "vehicle_report", [](const ParamReader& r) { return std::make_unique<VehicleReportAnalysis>(r); },
+      {"static corner/axle loads and heights (equilibrium solver) and suspension kinematics over wheel travel "
+       "(camber, toe, track change, recession, wheel rate, roll centre); tables kinematics_<axle>.csv",
+       {{"travel_range_m", "m", "0.08", "wheel travel +- this"}, {"travel_step_m", "m", "0.01", "travel step"}}});
+}
+
+}  // namespace vdyn
