@@ -139,7 +139,7 @@ class Iso7401Analysis : public Analysis {
                    {"steady_yaw_rate_rad_s", st.steady_yaw_rate_rad_s},
                    {"yaw_rate_gain_1_per_s", st.yaw_rate_gain_1_per_s},
                    {"yaw_response_time_s", st.yaw_response_time_s},
-                   {"yaw_peak_response_time_s", st.yaw_peak_response_time_s},
+                   {"yaw_peak_response_time_s", nullIfNan(st.yaw_peak_response_time_s)},
                    {"yaw_overshoot", st.yaw_overshoot},
                    {"lateral_accel_response_time_s", st.lateral_accel_response_time_s},
                    {"lateral_accel_overshoot", st.lateral_accel_overshoot},

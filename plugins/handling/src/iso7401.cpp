@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cmath>
+#include <limits>
 
 #include <Eigen/Dense>
 
@@ -95,13 +96,17 @@ StepSteerResult runStepSteer(const HandlingVehicle& v, const StepSteerSettings& 
                 formatValue(out.steady_yaw_rate_rad_s) + " rad/s");
   out.yaw_response_time_s = t90 - out.t50_s;
   const PeakAt pr = peak(h.t_s, h.yaw_rate_rad_s, sg);
-  out.yaw_peak_response_time_s = pr.t - out.t50_s;
-  out.yaw_overshoot = (pr.y - out.steady_yaw_rate_rad_s) / out.steady_yaw_rate_rad_s;
+  // A response that rises to its steady value without a peak has its largest
+  // value at the end of the run: no peak response time, no overshoot.
+  const bool rising = pr.t >= h.t_s.back() - 0.1 * set.duration_s;
+  out.yaw_peak_response_time_s = rising ? std::numeric_limits<double>::quiet_NaN() : pr.t - out.t50_s;
+  out.yaw_overshoot = rising ? 0.0 : (pr.y - out.steady_yaw_rate_rad_s) / out.steady_yaw_rate_rad_s;
   const double a90 = crossing(h.t_s, h.lateral_accel_m_s2, 0.9 * out.steady_lateral_accel_m_s2, t0);
   out.lateral_accel_response_time_s = a90 - out.t50_s;
   const PeakAt pa = peak(h.t_s, h.lateral_accel_m_s2, sg);
-  out.lateral_accel_peak_response_time_s = pa.t - out.t50_s;
-  out.lateral_accel_overshoot = (pa.y - out.steady_lateral_accel_m_s2) / out.steady_lateral_accel_m_s2;
+  const bool risingA = pa.t >= h.t_s.back() - 0.1 * set.duration_s;
+  out.lateral_accel_peak_response_time_s = risingA ? std::numeric_limits<double>::quiet_NaN() : pa.t - out.t50_s;
+  out.lateral_accel_overshoot = risingA ? 0.0 : (pa.y - out.steady_lateral_accel_m_s2) / out.steady_lateral_accel_m_s2;
   out.final_yaw_rate_rad_s = h.yaw_rate_rad_s.back();
   v.holdSteering(U, 0);
   return out;

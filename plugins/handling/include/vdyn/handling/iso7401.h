@@ -36,8 +36,10 @@ struct StepSteerResult {
   double lateral_accel_gain_m_s2_per_rad = 0;
   double t50_s = 0;                     ///< time the front angle passes 50 % of its step, s
   double yaw_response_time_s = 0;       ///< from t50 to 90 % of the steady yaw rate, s
-  double yaw_peak_response_time_s = 0;  ///< from t50 to the yaw-rate peak, s
-  double yaw_overshoot = 0;             ///< (peak - steady) / steady, 1
+  /// From t50 to the yaw-rate peak, s; NaN when the response rises to its
+  /// steady value without a peak (largest value in the run's last 10 %).
+  double yaw_peak_response_time_s = 0;
+  double yaw_overshoot = 0;             ///< (peak - steady) / steady, 1 (0 without a peak)
   double lateral_accel_response_time_s = 0, lateral_accel_peak_response_time_s = 0, lateral_accel_overshoot = 0;
   double final_yaw_rate_rad_s = 0;      ///< simulation's last sample (settling check)
   HandlingHistory history;
