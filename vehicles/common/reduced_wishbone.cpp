@@ -322,55 +322,23 @@ void ReducedKnuckleMobilizer::multiplyByHDotTranspose(const SimTK::State& s, con
 }
 
 // ---------------------------------------------------------------------------
-ArmCouplerImpl::ArmCouplerImpl(SimTK::SimbodyMatterSubsystem& matter, const WishboneLoop& loop,
-                               const SimTK::MobilizedBody& knuckle, const SimTK::MobilizedBody& lowerArm,
-                               const SimTK::MobilizedBody& upperArm)
-    : Implementation(matter, 2, 0, 0), loop_(loop) {
-  K_ = addConstrainedMobilizer(knuckle);
-  LA_ = addConstrainedMobilizer(lowerArm);
-  UA_ = addConstrainedMobilizer(upperArm);
+namespace {
+/// The plane of an arm through its pivot axis and its ball point (arm frame):
+/// the knuckle's ball point lies in it exactly when the arm's angle is the
+/// loop's (the knuckle point is on the arm's circle by construction).
+SimTK::Constraint::PointInPlane armPlane(const SimTK::MobilizedBody& arm, const JointParams& pivot,
+                                         const Vec3& armBall, const SimTK::MobilizedBody& knuckle,
+                                         const Vec3& knuckleBall, const std::string& what) {
+  const Vec3 axis = pivot.child_axis_point_m - pivot.child_point_m;
+  const Vec3 n = SimTK::cross(axis, armBall - pivot.child_point_m);
+  if (!(n.norm() > 1e-9 * axis.norm() * (armBall - pivot.child_point_m).norm()))
+    throw Error("reduced corner: the " + what + " ball joint lies on the arm's pivot axis");
+  const SimTK::UnitVec3 normal(n);
+  return SimTK::Constraint::PointInPlane(const_cast<SimTK::MobilizedBody&>(arm), normal,
+                                         SimTK::dot(normal.asVec3(), pivot.child_point_m),
+                                         const_cast<SimTK::MobilizedBody&>(knuckle), knuckleBall);
 }
-
-void ArmCouplerImpl::calcPositionErrors(const SimTK::State& s,
-                                        const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>&,
-                                        const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& q,
-                                        SimTK::Array_<SimTK::Real>& perr) const {
-  const double sq = getOneQ(s, q, K_, SimTK::MobilizerQIndex(0));
-  perr[0] = getOneQ(s, q, LA_, SimTK::MobilizerQIndex(0)) - sq;
-  perr[1] = getOneQ(s, q, UA_, SimTK::MobilizerQIndex(0)) - loop_.calcUpperArmAngle(sq)[0];
-}
-
-void ArmCouplerImpl::calcPositionDotErrors(const SimTK::State& s,
-                                           const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
-                                           const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qdot,
-                                           SimTK::Array_<SimTK::Real>& pverr) const {
-  const double sq = getOneQFromState(s, K_, SimTK::MobilizerQIndex(0));
-  const double sd = getOneQDot(s, qdot, K_, SimTK::MobilizerQIndex(0));
-  pverr[0] = getOneQDot(s, qdot, LA_, SimTK::MobilizerQIndex(0)) - sd;
-  pverr[1] = getOneQDot(s, qdot, UA_, SimTK::MobilizerQIndex(0)) - loop_.calcUpperArmAngle(sq)[1] * sd;
-}
-
-void ArmCouplerImpl::calcPositionDotDotErrors(const SimTK::State& s,
-                                              const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
-                                              const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qdd,
-                                              SimTK::Array_<SimTK::Real>& paerr) const {
-  const double sq = getOneQFromState(s, K_, SimTK::MobilizerQIndex(0));
-  const double sd = getOneQDotFromState(s, K_, SimTK::MobilizerQIndex(0));
-  const double sdd = getOneQDotDot(s, qdd, K_, SimTK::MobilizerQIndex(0));
-  const Vec3 f = loop_.calcUpperArmAngle(sq);
-  paerr[0] = getOneQDotDot(s, qdd, LA_, SimTK::MobilizerQIndex(0)) - sdd;
-  paerr[1] = getOneQDotDot(s, qdd, UA_, SimTK::MobilizerQIndex(0)) - f[1] * sdd - f[2] * sd * sd;
-}
-
-void ArmCouplerImpl::addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& lambda,
-                                                   SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
-                                                   SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const {
-  const double sq = getOneQFromState(s, K_, SimTK::MobilizerQIndex(0));
-  const double f1 = loop_.calcUpperArmAngle(sq)[1];
-  addInOneQForce(s, LA_, SimTK::MobilizerQIndex(0), lambda[0], qForces);
-  addInOneQForce(s, UA_, SimTK::MobilizerQIndex(0), lambda[1], qForces);
-  addInOneQForce(s, K_, SimTK::MobilizerQIndex(0), -lambda[0] - f1 * lambda[1], qForces);
-}
+}  // namespace
 
 // ---------------------------------------------------------------------------
 ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& chassis, const DoubleWishboneParams& p,
@@ -389,8 +357,10 @@ ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& c
   const SimTK::UnitVec3 spin(p.wheel_spin_axis);
   c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), makeRigidBody(p.wheel),
                                       pinFrame(Vec3(0), spin));
-  c.arm_coupler =
-      SimTK::Constraint::Custom(new ArmCouplerImpl(scene.updMatter(), loop, c.knuckle, c.lower_arm, c.upper_arm));
+  c.lower_plane = armPlane(c.lower_arm, p.lower_pivot, p.lower_ball.parent_point_m, c.knuckle,
+                           p.lower_ball.child_point_m, "lower");
+  c.upper_plane = armPlane(c.upper_arm, p.upper_pivot, p.upper_ball.parent_point_m, c.knuckle,
+                           p.upper_ball.child_point_m, "upper");
   c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
                                                 p.spring_arm_point_m, p.spring_stiffness_N_per_m,
                                                 p.spring_free_length_m);

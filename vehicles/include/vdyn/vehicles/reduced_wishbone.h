@@ -20,12 +20,15 @@
 // tests check them, and the arm coupling, by finite differences).
 //
 // The arms keep their bodies, masses and inertias on their own Pins (the
-// constrained model's joints 1 and 4): their angles are tied to s by two
-// holonomic coordinate rows per corner (theta_lower = s, theta_upper =
-// theta4(s)). No row closes the loop itself, so the loop closure and the
-// steering angle are exact by construction. A Simbody tree cannot do without
-// these two rows: every body whose pose depends on s needs a mobilizer of its
-// own, and only one body of a chain can depend on s alone.
+// constrained model's joints 1 and 4). Their angles are tied to s by one
+// holonomic row each: the knuckle's ball point (on the arm's circle by
+// construction) lies in the plane of the arm through its pivot axis and its
+// ball point (Constraint::PointInPlane, body-level; coordinate rows cost
+// Simbody a q-to-u force conversion per mobilizer and were slower). No row
+// closes the loop itself, so the loop closure and the steering angle are
+// exact by construction. A Simbody tree cannot do without these two rows:
+// every body whose pose depends on s needs a mobilizer of its own, and only
+// one body of a chain can depend on s alone.
 #include <string>
 
 #include <Simbody.h>
@@ -111,38 +114,15 @@ class ReducedKnuckleMobilizer : public SimTK::MobilizedBody::Custom::Implementat
   mutable Kinematics memo_;
 };
 
-/// Two holonomic rows per corner: theta_lower - s = 0, theta_upper - theta4(s) = 0.
-class ArmCouplerImpl : public SimTK::Constraint::Custom::Implementation {
- public:
-  ArmCouplerImpl(SimTK::SimbodyMatterSubsystem& matter, const WishboneLoop& loop, const SimTK::MobilizedBody& knuckle,
-                 const SimTK::MobilizedBody& lowerArm, const SimTK::MobilizedBody& upperArm);
-  Implementation* clone() const override { return new ArmCouplerImpl(*this); }
-  void calcPositionErrors(const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>&,
-                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& q,
-                          SimTK::Array_<SimTK::Real>& perr) const override;
-  void calcPositionDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
-                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qdot,
-                             SimTK::Array_<SimTK::Real>& pverr) const override;
-  void calcPositionDotDotErrors(const SimTK::State& s,
-                                const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
-                                const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qdotdot,
-                                SimTK::Array_<SimTK::Real>& paerr) const override;
-  void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
-                                     SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
-                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const override;
-
- private:
-  WishboneLoop loop_;
-  SimTK::ConstrainedMobilizerIndex K_, LA_, UA_;
-};
-
 /// Handles of a reduced corner built into a scene.
 struct ReducedWishboneCorner {
   SimTK::MobilizedBody::Pin lower_arm;   ///< its angle tied to s
   SimTK::MobilizedBody::Custom knuckle;  ///< q = [s, delta]
   SimTK::MobilizedBody::Pin upper_arm;   ///< its angle tied to theta4(s)
   SimTK::MobilizedBody::Pin wheel;
-  SimTK::Constraint::Custom arm_coupler;
+  /// The arms tied to s: each knuckle ball point in its arm's plane through
+  /// the pivot axis and the arm's ball point (one row each).
+  SimTK::Constraint::PointInPlane lower_plane, upper_plane;
   SimTK::Force::TwoPointLinearSpring spring;
   SimTK::Force::TwoPointLinearDamper damper;
   const WishboneLoop* loop = nullptr;  ///< owned by the caller (FourWsVehicle)
