@@ -1,6 +1,7 @@
 #include "vdyn/vehicles/reduced_wishbone.h"
 
 #include <cmath>
+#include <map>
 
 #include "vdyn/core/error.h"
 
@@ -326,19 +327,108 @@ namespace {
 /// The plane of an arm through its pivot axis and its ball point (arm frame):
 /// the knuckle's ball point lies in it exactly when the arm's angle is the
 /// loop's (the knuckle point is on the arm's circle by construction).
-SimTK::Constraint::PointInPlane armPlane(const SimTK::MobilizedBody& arm, const JointParams& pivot,
-                                         const Vec3& armBall, const SimTK::MobilizedBody& knuckle,
-                                         const Vec3& knuckleBall, const std::string& what) {
+ArmPlanesImpl::Row armRow(const SimTK::MobilizedBody& arm, const JointParams& pivot, const Vec3& armBall,
+                          const SimTK::MobilizedBody& knuckle, const Vec3& knuckleBall, const std::string& what) {
   const Vec3 axis = pivot.child_axis_point_m - pivot.child_point_m;
   const Vec3 n = SimTK::cross(axis, armBall - pivot.child_point_m);
   if (!(n.norm() > 1e-9 * axis.norm() * (armBall - pivot.child_point_m).norm()))
     throw Error("reduced corner: the " + what + " ball joint lies on the arm's pivot axis");
   const SimTK::UnitVec3 normal(n);
-  return SimTK::Constraint::PointInPlane(const_cast<SimTK::MobilizedBody&>(arm), normal,
-                                         SimTK::dot(normal.asVec3(), pivot.child_point_m),
-                                         const_cast<SimTK::MobilizedBody&>(knuckle), knuckleBall);
+  return {arm, knuckle, normal, SimTK::dot(normal.asVec3(), pivot.child_point_m), knuckleBall};
 }
 }  // namespace
+
+std::vector<ArmPlanesImpl::Row> armPlaneRows(const DoubleWishboneParams& p, const SimTK::MobilizedBody& lowerArm,
+                                             const SimTK::MobilizedBody& knuckle,
+                                             const SimTK::MobilizedBody& upperArm) {
+  return {armRow(lowerArm, p.lower_pivot, p.lower_ball.parent_point_m, knuckle, p.lower_ball.child_point_m, "lower"),
+          armRow(upperArm, p.upper_pivot, p.upper_ball.parent_point_m, knuckle, p.upper_ball.child_point_m, "upper")};
+}
+
+ArmPlanesImpl::ArmPlanesImpl(SimTK::SimbodyMatterSubsystem& matter, const std::vector<Row>& rows)
+    : Implementation(matter, int(rows.size()), 0, 0) {
+  std::map<SimTK::MobilizedBodyIndex, SimTK::ConstrainedBodyIndex> index;
+  auto body = [&](const SimTK::MobilizedBody& b) {
+    const auto it = index.find(b.getMobilizedBodyIndex());
+    if (it != index.end()) return it->second;
+    return index[b.getMobilizedBodyIndex()] = addConstrainedBody(b);
+  };
+  for (const Row& r : rows) rows_.push_back({body(r.arm), body(r.knuckle), r.normal_arm, r.height_m, r.point_knuckle});
+}
+
+void ArmPlanesImpl::calcPositionErrors(const SimTK::State&,
+                                       const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
+                                       const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                                       SimTK::Array_<SimTK::Real>& perr) const {
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const R& r = rows_[i];
+    const Vec3 p_AS = findStationLocation(X_AB, r.F, r.p);
+    const Vec3 p_BC = ~getBodyTransform(X_AB, r.B) * p_AS;
+    perr[int(i)] = SimTK::dot(p_BC, r.n.asVec3()) - r.h;
+  }
+}
+
+const std::vector<ArmPlanesImpl::Geo>& ArmPlanesImpl::geometry(const SimTK::State& s) const {
+  const SimTK::Vector& q = s.getQ();
+  bool same = geoQ_.size() == q.size() && !geo_.empty();
+  for (int i = 0; same && i < q.size(); ++i) same = geoQ_[i] == q[i];
+  if (same) return geo_;
+  geo_.resize(rows_.size());
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const R& r = rows_[i];
+    const SimTK::Transform& X_AF = getBodyTransformFromState(s, r.F);
+    const SimTK::Transform& X_AB = getBodyTransformFromState(s, r.B);
+    const Vec3 p_AS = X_AF * r.p;
+    geo_[i] = {X_AB.R() * r.n.asVec3(), p_AS - X_AF.p(), p_AS - X_AB.p()};
+  }
+  geoQ_ = q;
+  return geo_;
+}
+
+void ArmPlanesImpl::calcPositionDotErrors(const SimTK::State& s,
+                                          const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
+                                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                                          SimTK::Array_<SimTK::Real>& pverr) const {
+  const std::vector<Geo>& g = geometry(s);
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const R& r = rows_[i];
+    const SimTK::SpatialVec &VF = V_AB[r.F], &VB = V_AB[r.B];
+    // v_CS = v_S(F) - v_C(B), the station velocities from each body's origin.
+    const Vec3 v_CS = VF[1] + SimTK::cross(VF[0], g[i].rF) - VB[1] - SimTK::cross(VB[0], g[i].rB);
+    pverr[int(i)] = SimTK::dot(v_CS, g[i].n);
+  }
+}
+
+void ArmPlanesImpl::calcPositionDotDotErrors(const SimTK::State& s,
+                                             const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
+                                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                                             SimTK::Array_<SimTK::Real>& paerr) const {
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    const R& r = rows_[i];
+    const Vec3 p_AS = findStationLocationFromState(s, r.F, r.p);
+    const SimTK::Transform& X_AB = getBodyTransformFromState(s, r.B);
+    const Vec3 p_BC = ~X_AB * p_AS;
+    const Vec3 n_A = X_AB.R() * r.n.asVec3();
+    const Vec3& w_AB = getBodyAngularVelocityFromState(s, r.B);
+    const Vec3 v_CS = findStationVelocityFromState(s, r.F, r.p) - findStationVelocityFromState(s, r.B, p_BC);
+    const Vec3 a_CS = findStationAcceleration(s, A_AB, r.F, r.p) - findStationAcceleration(s, A_AB, r.B, p_BC);
+    paerr[int(i)] = SimTK::dot(a_CS - 2. * SimTK::cross(w_AB, v_CS), n_A);
+  }
+}
+
+void ArmPlanesImpl::addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& lambda,
+                                                  SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& F_A,
+                                                  SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&) const {
+  const std::vector<Geo>& g = geometry(s);
+  for (std::size_t i = 0; i < rows_.size(); ++i) {
+    if (lambda[int(i)] == 0) continue;  // G^T column by column: most multipliers are zero
+    const R& r = rows_[i];
+    // lambda n at S on the knuckle, -lambda n at the coincident point C of the arm.
+    const Vec3 f = lambda[int(i)] * g[i].n;
+    F_A[r.F] += SimTK::SpatialVec(SimTK::cross(g[i].rF, f), f);
+    F_A[r.B] -= SimTK::SpatialVec(SimTK::cross(g[i].rB, f), f);
+  }
+}
 
 // ---------------------------------------------------------------------------
 ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& chassis, const DoubleWishboneParams& p,
@@ -357,10 +447,6 @@ ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& c
   const SimTK::UnitVec3 spin(p.wheel_spin_axis);
   c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), makeRigidBody(p.wheel),
                                       pinFrame(Vec3(0), spin));
-  c.lower_plane = armPlane(c.lower_arm, p.lower_pivot, p.lower_ball.parent_point_m, c.knuckle,
-                           p.lower_ball.child_point_m, "lower");
-  c.upper_plane = armPlane(c.upper_arm, p.upper_pivot, p.upper_ball.parent_point_m, c.knuckle,
-                           p.upper_ball.child_point_m, "upper");
   c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
                                                 p.spring_arm_point_m, p.spring_stiffness_N_per_m,
                                                 p.spring_free_length_m);

@@ -81,6 +81,15 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
                   [wheel](const SimTK::State& s) { return wheel.getOneU(s, 0); }});
   }
 
+  if (reduced_) {  // every arm row in one constraint object
+    std::vector<ArmPlanesImpl::Row> rows;
+    for (int c = 0; c < 4; ++c) {
+      const auto r = armPlaneRows(cornerParams_[c], reducedCorners_[c].lower_arm, reducedCorners_[c].knuckle,
+                                  reducedCorners_[c].upper_arm);
+      rows.insert(rows.end(), r.begin(), r.end());
+    }
+    SimTK::Constraint::Custom(new ArmPlanesImpl(sc.updMatter(), rows));
+  }
   addChassisOutputs(sc, chassis_);
 }
 

@@ -23,13 +23,15 @@
 // constrained model's joints 1 and 4). Their angles are tied to s by one
 // holonomic row each: the knuckle's ball point (on the arm's circle by
 // construction) lies in the plane of the arm through its pivot axis and its
-// ball point (Constraint::PointInPlane, body-level; coordinate rows cost
-// Simbody a q-to-u force conversion per mobilizer and were slower). No row
+// ball point (the equations of Constraint::PointInPlane, body-level, all
+// corners' rows in one constraint object; coordinate rows cost Simbody a
+// q-to-u force conversion per mobilizer and were slower). No row
 // closes the loop itself, so the loop closure and the steering angle are
 // exact by construction. A Simbody tree cannot do without these two rows:
 // every body whose pose depends on s needs a mobilizer of its own, and only
 // one body of a chain can depend on s alone.
 #include <string>
+#include <vector>
 
 #include <Simbody.h>
 
@@ -114,21 +116,76 @@ class ReducedKnuckleMobilizer : public SimTK::MobilizedBody::Custom::Implementat
   mutable Kinematics memo_;
 };
 
+/// The arm rows of every reduced corner of a vehicle in one Constraint::Custom
+/// (one row per arm): each knuckle ball point S lies in its arm's plane
+/// through the pivot axis and the arm's ball point, the equations of
+/// Simbody's Constraint::PointInPlane (perr = p_BS . n - h, verr = v_CS . n,
+/// aerr = (a_CS - 2 w_B x v_CS) . n, force lambda n on S and -lambda n on the
+/// arm's coincident point C). One constraint object instead of eight: Simbody
+/// visits every constraint object for every row of G M^-1 G^T.
+class ArmPlanesImpl : public SimTK::Constraint::Custom::Implementation {
+ public:
+  struct Row {
+    SimTK::MobilizedBody arm, knuckle;
+    SimTK::UnitVec3 normal_arm;  ///< plane normal in the arm frame
+    double height_m = 0;         ///< plane: normal . p = height (arm frame)
+    SimTK::Vec3 point_knuckle;   ///< the knuckle's ball point (knuckle frame)
+  };
+  ArmPlanesImpl(SimTK::SimbodyMatterSubsystem& matter, const std::vector<Row>& rows);
+  Implementation* clone() const override { return new ArmPlanesImpl(*this); }
+  void calcPositionErrors(const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>& X_AB,
+                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                          SimTK::Array_<SimTK::Real>& perr) const override;
+  void calcPositionDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& V_AB,
+                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                             SimTK::Array_<SimTK::Real>& pverr) const override;
+  void calcPositionDotDotErrors(const SimTK::State& s,
+                                const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& A_AB,
+                                const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&,
+                                SimTK::Array_<SimTK::Real>& paerr) const override;
+  void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
+                                     SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>& bodyForcesInA,
+                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>&) const override;
+
+ private:
+  struct R {
+    SimTK::ConstrainedBodyIndex B, F;  // arm (plane), knuckle (follower)
+    SimTK::UnitVec3 n;
+    double h;
+    SimTK::Vec3 p;
+  };
+  std::vector<R> rows_;
+  /// Position-stage quantities of every row (n_A and the station offsets of S
+  /// from the knuckle's and the arm's origins, in A), kept for the q they were
+  /// computed at: Simbody multiplies by G and G^T once per row of G M^-1 G^T
+  /// at the same positions. Not thread-safe, as ReducedKnuckleMobilizer.
+  struct Geo {
+    SimTK::Vec3 n, rF, rB;
+  };
+  const std::vector<Geo>& geometry(const SimTK::State& s) const;
+  mutable SimTK::Vector geoQ_;
+  mutable std::vector<Geo> geo_;
+};
+
+/// The two rows (lower, upper arm) of a reduced corner for ArmPlanesImpl.
+std::vector<ArmPlanesImpl::Row> armPlaneRows(const DoubleWishboneParams& p, const SimTK::MobilizedBody& lowerArm,
+                                             const SimTK::MobilizedBody& knuckle,
+                                             const SimTK::MobilizedBody& upperArm);
+
 /// Handles of a reduced corner built into a scene.
 struct ReducedWishboneCorner {
   SimTK::MobilizedBody::Pin lower_arm;   ///< its angle tied to s
   SimTK::MobilizedBody::Custom knuckle;  ///< q = [s, delta]
   SimTK::MobilizedBody::Pin upper_arm;   ///< its angle tied to theta4(s)
   SimTK::MobilizedBody::Pin wheel;
-  /// The arms tied to s: each knuckle ball point in its arm's plane through
-  /// the pivot axis and the arm's ball point (one row each).
-  SimTK::Constraint::PointInPlane lower_plane, upper_plane;
   SimTK::Force::TwoPointLinearSpring spring;
   SimTK::Force::TwoPointLinearDamper damper;
   const WishboneLoop* loop = nullptr;  ///< owned by the caller (FourWsVehicle)
 };
 
-/// The reduced corner (bodies registered as in buildDoubleWishbone).
+/// The reduced corner (bodies registered as in buildDoubleWishbone). Its two
+/// arm rows are not added here: collect armPlaneRows() of every corner into
+/// one ArmPlanesImpl (FourWsVehicle does).
 ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& chassis, const DoubleWishboneParams& p,
                                            const WishboneLoop& loop, const std::string& prefix);
 
