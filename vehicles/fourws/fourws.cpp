@@ -53,6 +53,7 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
   p_.validate();
   Scene& sc = *scene_;
   reduced_ = p_.corner_model == "reduced";
+  if (reduced_) registry_ = std::make_shared<PluginRegistry>(registry);
   SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
   chassis_ = SimTK::MobilizedBody::Free(
       sc.updMatter().Ground(), SimTK::Transform(),
@@ -96,6 +97,7 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
 const SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bool front,
                                                      std::shared_ptr<const SteeringCommand> command) {
   const int r = front ? RF : RR, l = front ? LF : LR;
+  axleSteering_.push_back({name, front, command, 0.0});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{std::string(cornerName(r)) + ".knuckle", std::string(cornerName(l)) + ".knuckle"},
       std::move(command), SimTK::UnitVec3(cornerParams_[r].wheel_spin_axis));
@@ -104,6 +106,7 @@ const SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bo
 
 SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bool front, const SteeringStateSpec& state) {
   const int r = front ? RF : RR, l = front ? LF : LR;
+  axleSteering_.push_back({name, front, nullptr, state.initial_angle_rad});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{std::string(cornerName(r)) + ".knuckle", std::string(cornerName(l)) + ".knuckle"},
       state, SimTK::UnitVec3(cornerParams_[r].wheel_spin_axis));
@@ -140,19 +143,37 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
       bodies.push_back({n + b, scene_->getBody(n + b)});
   }
   double gap = 0;  // the reduced loop is closed by construction
+  AssemblyReport conReport;
+  if (reduced_) {
+    // The constrained model's assembly (same data, axle steering held at its
+    // initial angles), read into the reduced coordinates.
+    FourWsParams cp = p_;
+    cp.corner_model = "constrained";
+    FourWsVehicle con(cp, *registry_);
+    for (const AxleSteering& a : axleSteering_)
+      con.addAxleSteering(a.name, a.front,
+                          std::make_shared<HoldCommand>(a.command ? a.command->calcAt(s.getTime()).angle_rad
+                                                                  : a.initial_angle_rad));
+    const SimTK::State cs = con.makeInitialState(0.0, &conReport);
+    chassis_.setQ(s, con.chassis().getQ(cs));
+    for (int c = 0; c < 4; ++c) {
+      const SimTK::UnitVec3 spin(cornerParams_[c].wheel_spin_axis);
+      setReducedCornerPosition(s, reducedCorners_[c], con.suspensionAngle(cs, c),
+                               steeringAngle(cs, con.chassis(), con.corner(c).knuckle, spin));
+    }
+    gap = conReport.initial_loop_gap_m;
+  }
   std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex()};
   for (int c = 0; c < 4; ++c) {
     locked.push_back(scene_->getBody(std::string(cornerName(c)) + ".wheel").getMobilizedBodyIndex());
-    if (reduced_) {
-      setReducedCornerPosition(s, reducedCorners_[c], 0, 0);  // the lower arm as tabulated
-      continue;
-    }
+    if (reduced_) continue;
     const auto& j = cornerParams_[c].upper_ball;
     gap = std::max(gap, (corners_[c].upper_arm.findStationLocationInGround(s, j.parent_point_m) -
                          corners_[c].knuckle.findStationLocationInGround(s, j.child_point_m)).norm());
   }
   for (auto mbx : steeringStateBodies(*scene_)) locked.push_back(mbx);  // keep delta at its initial value
   assembleLoops(system, s, locked, bodies, gap, "4ws", report);
+  if (reduced_ && report) *report = conReport;  // the moves that made this configuration
   // Moving forward with every body at the chassis velocity and the wheels rolling.
   s.updU() = 0;
   chassis_.setUToFitLinearVelocity(s, Vec3(speed, 0, 0));

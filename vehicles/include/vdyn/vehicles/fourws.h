@@ -57,6 +57,10 @@ class FourWsVehicle {
   /// The tabulated configuration (chassis c.m. at the height where the tires
   /// carry about the weight, level, at the origin heading +x), the four loops
   /// closed by assembly, moving forward at `speed_m_s` with the wheels rolling.
+  /// The reduced model starts in the constrained model's assembled
+  /// configuration (a constrained copy of the vehicle, with the axle steering
+  /// held at its initial angles, is assembled and its positions read), so
+  /// both models start from the same state.
   SimTK::State makeInitialState(double speed_m_s = 0.0, AssemblyReport* report = nullptr) const;
 
   /// Adds a steering plugin that commands both wheels of the front (or rear)
@@ -96,6 +100,14 @@ class FourWsVehicle {
   bool reduced_ = false;
   std::array<std::unique_ptr<WishboneLoop>, 4> loops_;
   std::array<ReducedWishboneCorner, 4> reducedCorners_;
+  std::shared_ptr<const PluginRegistry> registry_;  ///< reduced: for the constrained copy
+  struct AxleSteering {
+    std::string name;
+    bool front;
+    std::shared_ptr<const SteeringCommand> command;  ///< null: state-driven
+    double initial_angle_rad;
+  };
+  std::vector<AxleSteering> axleSteering_;
   std::array<const TirePlugin*, 4> tires_{};
 };
 
