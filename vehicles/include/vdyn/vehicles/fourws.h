@@ -1,5 +1,5 @@
 #pragma once
-// The seed's Appendix A four-wheel-steering vehicle (DESIGN.md section 9): the
+// The seed's Appendix A four-wheel-steering vehicle (docs/vehicle_data.md): the
 // chassis on a free (6-dof) mobilizer, four double-wishbone corners (the left
 // ones mirrored from the right in the builder), four wheels on spin joints, the
 // suspension spring-dampers and four tire plugins on the scene's road. Steering
