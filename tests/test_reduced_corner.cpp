@@ -1,7 +1,8 @@
 // The reduced corner model (vehicles/reduced_wishbone.h) against the
 // constrained one: loop closure and steering angle exact by construction,
-// H and HDot and the arm coupling by finite differences, the same ch3 steady
-// state (steady-state solver on both) and the same transient.
+// H and HDot and the arm rows by finite differences, the same ch3 steady
+// state (steady-state solver on both), the same transient and the same mixed
+// sensitivity.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -9,6 +10,8 @@
 
 #include "test_util.h"
 #include "vdyn/core/simulation.h"
+#include "vdyn/sensitivity/sensitivity.h"
+#include "vdyn/sensitivity/vehicle_designs.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/vehicles/fourws.h"
@@ -227,4 +230,26 @@ TEST(ReducedCorner, SameCh3TransientAsTheConstrainedModel) {
     EXPECT_GT(scale, 1e-3) << n;  // the vehicle is turning: the comparison is not trivial
     EXPECT_LT(err / scale, 1e-6) << n;
   }
+}
+
+TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
+  // d psi / d (front spring stiffness), psi = int roll rate^2 over the first
+  // second of the chapter 3 manoeuvre (ch4_sensitivity --vehicle fourws), by
+  // the mixed method on each model.
+  SensitivityResult r[2];
+  const char* models[2] = {"constrained", "reduced"};
+  for (int m = 0; m < 2; ++m) {
+    SensitivityProblem p;
+    p.model = std::make_shared<FourWsDesign>(params(models[m], "appendix_a_relaxation.json"), FourWsManoeuvre{});
+    p.parameters = {"front.spring.stiffness_N_per_m"};
+    p.cost = CostFunctional::parse("integral_of_square:chassis.roll_rate_rad_s");
+    p.t_end_s = 1.0;
+    p.integrator.accuracy = 1e-8;
+    SensitivitySettings set;
+    set.tolerance = 1e-4;
+    r[m] = makeSensitivityMethod("mixed", set)->compute(p);
+  }
+  EXPECT_GT(std::abs(r[0].dpsi_db[0]), 0.0);
+  EXPECT_NEAR(r[1].psi / r[0].psi, 1.0, 1e-6);
+  EXPECT_NEAR(r[1].dpsi_db[0] / r[0].dpsi_db[0], 1.0, 1e-3);
 }

@@ -57,6 +57,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
   SimTK::Vector yPrev, ydotPrev;
   double tPrev = t0;
+  int ownRealizations = 0;
   if (ownInterpolation) {
     const SimTK::State& s0 = integ->getState();
     scene.getSystem().realize(s0, SimTK::Stage::Acceleration);
@@ -67,7 +68,13 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   auto sampleStep = [&](const SimTK::State& adv) {
     const double t1 = adv.getTime();
     if (!(t1 > tPrev)) return;
-    scene.getSystem().realize(adv, SimTK::Stage::Acceleration);  // the next step's first stage: no extra work
+    // The next step's first stage (the integrator then finds it done and does
+    // not count it): counted here, so `realizations` stays the number of
+    // forward-dynamics evaluations.
+    if (adv.getSystemStage() < SimTK::Stage::Acceleration) {
+      scene.getSystem().realize(adv, SimTK::Stage::Acceleration);
+      ++ownRealizations;
+    }
     const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
     while (lastReported < s.t_end_s - tEndTol && nextReport() <= t1 + tEndTol) {
       const double tr = std::min(nextReport(), t1);
@@ -119,7 +126,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   state = integ->getState();
   sum.steps = integ->getNumStepsTaken();
   sum.attempts = integ->getNumStepsAttempted();
-  sum.realizations = integ->getNumRealizations();
+  sum.realizations = integ->getNumRealizations() + ownRealizations;
   sum.projections = integ->getNumProjections();
   sum.sim_time_s = s.t_end_s - t0;
   sum.wall_time_s =

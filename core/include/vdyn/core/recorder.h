@@ -1,6 +1,8 @@
 #pragma once
 // Samples chosen scene outputs at report times. The simulation loop hands it the
-// integrator's interpolated states, so reporting never forces an integrator step.
+// integrator's interpolant (recordInterpolated) or its interpolated states, so
+// reporting never forces an integrator step, copies no State per sample and
+// projects nothing.
 #include <string>
 #include <vector>
 
