@@ -8,6 +8,7 @@
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/core/fields.h"
 #include "vdyn/core/plugin_library.h"
+#include "vdyn/forces/body_force.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/fourws.h"
@@ -230,4 +231,63 @@ TEST(PluginLibrary, NamedErrors) {
   EXPECT_TRUE(contains(abi, "built for plugin ABI version " + std::to_string(VDYN_PLUGIN_ABI_VERSION + 100) +
                                 ", this vdyn has version " + std::to_string(VDYN_PLUGIN_ABI_VERSION)))
       << abi;
+}
+
+// body_force: the rise, hold and fall of its scale (closed form).
+TEST(BodyForce, ScaleRisesHoldsAndFalls) {
+  BodyForceParams p;
+  p.force_N = SimTK::Vec3(1, 0, 0);
+  p.start_time_s = 1.0;
+  p.rise_time_s = 0.5;
+  p.duration_s = 2.0;
+  EXPECT_EQ(p.scale(0.9), 0.0);
+  EXPECT_DOUBLE_EQ(p.scale(1.25), 0.5);
+  EXPECT_EQ(p.scale(2.0), 1.0);
+  EXPECT_DOUBLE_EQ(p.scale(3.75), 0.5);  // falling: 3.5 .. 4.0
+  EXPECT_EQ(p.scale(4.5), 0.0);
+  p.rise_time_s = 0;
+  p.duration_s = 0;
+  EXPECT_EQ(p.scale(0.999), 0.0);
+  EXPECT_EQ(p.scale(1.0), 1.0);
+  EXPECT_EQ(p.scale(100.0), 1.0);
+}
+
+// Static equilibrium of the quarter car through the scene path: the chassis
+// slides vertically, so the tire carries the whole weight plus a downward
+// body_force on the chassis: Fz = m g + F (force balance, closed form).
+TEST(SceneAnalyses, StaticEquilibriumTireCarriesWeightPlusBodyForce) {
+  auto scene = [](double F) {
+    Json j = R"({
+      "vehicle": {"type": "quarter_car", "data": "quarter_car.json"},
+      "analysis": {"type": "static_equilibrium", "ineffective_bodies": ["wheel"]}
+    })"_json;
+    if (F != 0)
+      j["plugins"] = Json::array({{{"type", "body_force"}, {"name", "push"}, {"attach", "chassis"},
+                                   {"force_N", {0.0, 0.0, -F}}}});
+    return SceneDescription::fromJson(j, "qc.json", standardRegistry());
+  };
+  const Json plain = runScene(scene(0)), pushed = runScene(scene(300));  // (1000 N bottoms the linkage)
+  const double mg = 226.0 * 9.81;  // quarter_car.json: 200 kg chassis + 26 kg corner, g = 9.81 m/s^2
+  // The solver stops at a generalized-force residual of 1e-6 N (its default).
+  EXPECT_NEAR(plain["equilibrium"]["tire.Fz_N"].get<double>(), mg, 1e-5);
+  EXPECT_NEAR(pushed["equilibrium"]["tire.Fz_N"].get<double>(), mg + 300, 1e-5);
+  EXPECT_EQ(pushed["equilibrium"]["push.Fz_N"].get<double>(), -300);
+  EXPECT_LT(pushed["equilibrium"]["chassis.z_m"].get<double>(), plain["equilibrium"]["chassis.z_m"].get<double>());
+}
+
+// Continuation in the speed hold's adjustable speed finds, at its first value,
+// the steady state the steady_state analysis solves directly (same equations
+// and start: equal to the solver's precision), and a higher yaw rate at 12 m/s.
+TEST(SceneAnalyses, ContinuationAgreesWithSteadyState) {
+  Json j = smallScene().json();
+  j["analysis"] = R"({"type": "steady_state"})"_json;
+  const Json ss = runScene(SceneDescription::fromJson(j, "small.json", standardRegistry()));
+  j["analysis"] = R"({"type": "continuation", "plugin": "speed_hold", "key": "speed_m_s", "values": [10, 12]})"_json;
+  const Json co = runScene(SceneDescription::fromJson(j, "small.json", standardRegistry()));
+  ASSERT_EQ(co["converged_points"].get<int>(), 2);
+  const double r10 = co["points"][0]["outputs"]["chassis.yaw_rate_rad_s"].get<double>();
+  const double r12 = co["points"][1]["outputs"]["chassis.yaw_rate_rad_s"].get<double>();
+  EXPECT_NEAR(r10, ss["steady"]["chassis.yaw_rate_rad_s"].get<double>(), 1e-9);
+  EXPECT_GT(r12, r10);
+  EXPECT_EQ(co["points"][1]["value"].get<double>(), 12.0);
 }

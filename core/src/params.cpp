@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cstdlib>
 #include <fstream>
+
+#include <dlfcn.h>
 #include <sys/stat.h>
 
 namespace vdyn {
@@ -18,21 +20,46 @@ Json readJsonFile(const std::string& path) {
 }
 
 std::vector<std::string> dataSearchPath() {
-  std::vector<std::string> path;
+  std::vector<std::string> dirs;
   if (const char* env = std::getenv("VDYN_DATA_PATH")) {
-    std::string item;
-    for (const char* c = env;; ++c) {
-      if (*c == ':' || *c == 0) {
-        if (!item.empty()) path.push_back(item);
-        item.clear();
-        if (*c == 0) break;
-      } else {
-        item += *c;
-      }
+    std::string list(env);
+    size_t start = 0;
+    while (start <= list.size()) {
+      const size_t end = std::min(list.find(':', start), list.size());
+      if (end > start) dirs.push_back(list.substr(start, end - start));
+      start = end + 1;
     }
   }
-  path.push_back(VDYN_DATA_DIR);
-  return path;
+  // The object file holding this function: libvdyn_core.so (or the program,
+  // for a static build); the installed data folder is relative to it.
+  std::string installed;
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&dataSearchPath), &info) != 0 && info.dli_fname != nullptr) {
+    std::string lib(info.dli_fname);
+    const size_t slash = lib.find_last_of('/');
+    installed = (slash == std::string::npos ? std::string(".") : lib.substr(0, slash)) + "/" + VDYN_LIB_TO_DATA;
+  }
+  struct stat st;
+  if (!installed.empty() && stat(installed.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    dirs.push_back(installed);
+  else
+    dirs.push_back(VDYN_BUILD_DATA_DIR);
+  return dirs;
+}
+
+std::string resolveDataPath(const std::string& name) {
+  struct stat st;
+  if (stat(name.c_str(), &st) == 0) return name;
+  const std::vector<std::string> dirs = dataSearchPath();
+  std::string looked = "the working directory";
+  if (name.empty() || name[0] != '/') {
+    for (const std::string& dir : dirs) {
+      const std::string candidate = dir + "/" + name;
+      if (stat(candidate.c_str(), &st) == 0) return candidate;
+      looked += ", " + dir;
+    }
+  }
+  throw Error("data file '" + name + "' not found (looked in " + looked + ")");
 }
 
 static bool fileExists(const std::string& p) {
@@ -44,15 +71,6 @@ static std::string joinFolders(const std::vector<std::string>& folders) {
   std::string s;
   for (const auto& f : folders) s += (s.empty() ? "" : ", ") + f;
   return s;
-}
-
-std::string resolveDataPath(const std::string& name) {
-  if (fileExists(name)) return name;
-  if (!name.empty() && name[0] != '/')
-    for (const auto& dir : dataSearchPath())
-      if (fileExists(dir + "/" + name)) return dir + "/" + name;
-  throw Error("data file '" + name + "' not found (looked in the working directory and " +
-              joinFolders(dataSearchPath()) + ")");
 }
 
 std::string resolveDataPath(const std::string& name, const std::string& namingFile) {

@@ -1,5 +1,5 @@
 // ch6_steering_ratio: the seed's optimal 4WS steering ratio Kr = delta_r /
-// delta_f (chapters 5-6, 8.1; DESIGN.md section 5), plugins/steering_ratio:
+// delta_f (chapters 5-6, 8.1; docs/equations.md "Steering ratio"), plugins/steering_ratio:
 //  - Figure 6.2: the linear bicycle's Kr(U) (6.9) for U = 2..35 m/s, from
 //    vehicles/data/ch6_linear_bicycle.json (the seed's chapter-6 constants);
 //  - Figure 6.4: the App. A vehicle's optimal Kr (6.12)-(6.15) over front angles
@@ -23,7 +23,8 @@
 #include <thread>
 
 #include "study.h"
-#include "vdyn/speed/speed_hold.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/steering_ratio.h"
@@ -163,6 +164,9 @@ int main(int argc, char** argv) {
 
     // --- Figure 6.4: nonlinear map, one thread per speed -------------------------
     const FourWsParams params = FourWsParams::fromFile(vm["data"].as<std::string>());
+    const SceneDescription sceneBase =
+        SceneDescription::fromFile("scenes/ch6_steering_ratio.json", standardRegistry(),
+                                   {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}});
     SteadyStateOptions sso;
     // Converging solves here take about 4 iterations; a failing one (beyond the
     // branch's end) spends all of them, most with a fresh Jacobian: 30, not 60.
@@ -193,27 +197,26 @@ int main(int argc, char** argv) {
         const auto ts = std::chrono::steady_clock::now();
         try {
           const double U = speeds[i];
-          std::unique_ptr<FourWsVehicle> car;
-          auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
-          const SpeedHoldPlugin* hold = nullptr;
-          {
-            // Building goes through the shared plugin registry: one at a time.
-            std::lock_guard<std::mutex> lock(buildMutex);
-            car = std::make_unique<FourWsVehicle>(params);
-            car->addAxleSteering("front_steer", true, front);
-            car->addAxleSteering("rear_steer", false, rear);
-            hold = &static_cast<const SpeedHoldPlugin&>(
-                car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U)));
-          }
-          const Scene& sc = car->getScene();
+          // The composition is the scene (scenes/ch6_steering_ratio.json: held
+          // front and rear steering, speed hold) at this speed, built as
+          // `vdyn run` does; the steering angles change through the plugins'
+          // adjustable angle_rad (continuation without rebuilding).
+          const BuiltScene built = sceneBase
+                                       .withOverrides({{"vehicle.initial_speed_m_s", U},
+                                                       {"plugins.speed_hold.speed_m_s", U}})
+                                       .build();
+          const Scene& sc = built.scene();
+          const Plugin& front = *sc.findPlugin<Plugin>("front_steer");
+          const Plugin& rear = *sc.findPlugin<Plugin>("rear_steer");
+          const Plugin& hold = *sc.findPlugin<Plugin>("speed_hold");
           SteadyStateSolver solver(
               sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0), sso);
-          SimTK::State s0 = car->makeInitialState(U);
-          hold->setSpeed(s0, U);
+          SimTK::State s0 = built.makeInitialState();
+          hold.setAdjustable(s0, "speed_m_s", U);
           const SteadyStateResult straight = solver.solve(s0);  // front 0: straight running
-          const SetSteering steer = [&](SimTK::State&, double f, double r) {
-            front->setAngle(f);
-            rear->setAngle(r);
+          const SetSteering steer = [&](SimTK::State& st, double f, double r) {
+            front.setAdjustable(st, "angle_rad", f);
+            rear.setAdjustable(st, "angle_rad", r);
           };
           const SideSlipOf slip = [&](const SimTK::State& s) { return sc.evalOutput("chassis.side_slip_rad", s); };
           const double kr0 = std::clamp(calcLinearOptimalRatio(lin, U), -1.0, 1.0);

@@ -1,4 +1,4 @@
-// ch8_maneuvers: the seed's chapter 8 comparison (DESIGN.md section 7): the
+// ch8_maneuvers: the seed's chapter 8 comparison (docs/equations.md "Manoeuvres"): the
 // App. A 4WS vehicle at constant speed follows three lane changes and two
 // J-turns with the path controller (7.9)-(7.18) on the front wheels, under
 // three rear-steer strategies (8.1)-(8.8): 2ws, linear (Kr of the linear
@@ -15,8 +15,10 @@
 
 #include "path_study.h"
 #include "study.h"
+#include "vdyn/core/scene_file.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/path_control/path_control.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/fourws.h"
@@ -31,7 +33,7 @@ struct Scenario {
   double speed_m_s = 0, t_end_s = 0;
   double abort_path_error_m = 2.0;
   double path_peak_ay = 0;  ///< U^2 times the reference's largest curvature, m/s^2
-  Json path_json;
+  Json path_json, gains_json;
   std::shared_ptr<const ReferencePath> path;
   PathControlParams gains;
   RearSteerParams rear;
@@ -51,25 +53,29 @@ std::vector<std::string> splitList(const std::string& s) {
   return out;
 }
 
-RunResult runOne(const FourWsParams& vp, const Scenario& sc, const std::string& strategyName,
-                 const LinearBicycleParams& linear, const KrTable& table, const SimulationSettings& base,
-                 const std::string& out) {
+RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::string& strategyName,
+                 const SimulationSettings& baseSim, const std::string& out) {
   RunResult r;
   r.csv = out + "/" + sc.id + "_" + strategyName + ".csv";
   r.summary = {{"scenario", sc.id}, {"strategy", strategyName}, {"speed_m_s", sc.speed_m_s}};
   try {
-    FourWsVehicle car(vp);
-    car.addAxleSteering("front_steer", true, SteeringStateSpec{});
-    car.addAxleSteering("rear_steer", false, SteeringStateSpec{});
-    Scene& scene = car.updScene();
-    scene.addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis", sc.path, sc.gains));
-    scene.addPlugin(std::make_unique<RearSteerPlugin>("rear_control", "rear_steer", "front_steer", "chassis",
-                                                      makeRearSteerStrategy(strategyName, linear, &table), sc.rear));
-    scene.addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", sc.speed_m_s));
-    SimTK::State s = car.makeInitialState(sc.speed_m_s);
-    SimulationSettings sim = base;
+    // The composition is the scene (scenes/ch8_maneuvers.json: 4WS vehicle,
+    // state-driven front and rear steering, path controller, rear-steer law,
+    // speed hold) with this scenario and strategy, built as `vdyn run` does;
+    // the run loop (abort on losing the path) and the recording are the study's.
+    const BuiltScene built = base.withOverrides({{"vehicle.initial_speed_m_s", sc.speed_m_s},
+                                                 {"plugins.speed_hold.speed_m_s", sc.speed_m_s},
+                                                 {"plugins.path_control.path", sc.path_json},
+                                                 {"plugins.path_control.gains", sc.gains_json},
+                                                 {"plugins.rear_control.strategy", strategyName},
+                                                 {"plugins.rear_control.g1_per_s2", sc.rear.g1_per_s2},
+                                                 {"plugins.rear_control.g2_per_s", sc.rear.g2_per_s}})
+                                    .build();
+    const Scene& scene = built.scene();
+    SimTK::State s = built.makeInitialState();
+    SimulationSettings sim = baseSim;
     sim.t_end_s = sc.t_end_s;
-    Recorder rec(car.getScene(),
+    Recorder rec(scene,
                  {"chassis.x_m", "chassis.y_m", "chassis.yaw_rad", "chassis.yaw_rate_rad_s",
                   "chassis.lateral_speed_m_s", "chassis.roll_rad", "front_steer.angle_rad", "front_steer.command_rad",
                   "front_steer.rate_rad_s", "front_steer.accel_rad_s2", "front_steer.drift_rad",
@@ -80,9 +86,9 @@ RunResult runOne(const FourWsParams& vp, const Scenario& sc, const std::string& 
     // A run that has lost the path is stopped (an unstable loop would crawl on
     // with ever smaller steps) and recorded as failed.
     const auto progress = study::progress(sc.id + " " + strategyName, sim.t_end_s);
-    const Scene& scene0 = car.getScene();
+    const Scene& scene0 = scene;
     const double limit = sc.abort_path_error_m;
-    const RunSummary run = simulate(car.getScene(), s, sim, &rec, [&](const SimTK::State& st) {
+    const RunSummary run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
       if (progress) progress(st);
       const double d = scene0.evalOutput("path_control.path_distance_m", st);
       if (!(std::abs(d) <= limit))
@@ -175,7 +181,7 @@ int main(int argc, char** argv) {
         "scenario", po::value<std::string>(), "comma-separated scenario ids to run (default: all)")(
         "strategy", po::value<std::string>(), "comma-separated strategies: 2ws, linear, nonlinear (default: all)")(
         "lane-change-length", po::value<std::string>(),
-        "how the seed's lane-change distance reads: 'full' (DESIGN.md: the whole lane change, X_f - X_0) or "
+        "how the seed's lane-change distance reads: 'full' (the whole lane change, X_f - X_0; docs/equations.md) or "
         "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
         "no-plots", "skip the PNG plots");
     study::addIntegratorOptions(opts);
@@ -183,7 +189,8 @@ int main(int argc, char** argv) {
                                  "lane changes and J-turns of the 4WS vehicle under three rear-steer strategies (ch. 8)",
                                  argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
-    const FourWsParams vp = FourWsParams::fromFile(data.string("vehicle_data"));
+    const std::string vehicleData = resolveDataPath(data.string("vehicle_data"));
+    FourWsParams::fromFile(vehicleData);  // a bad vehicle file is an error before any run
     const std::string tablePath = vm.count("kr-table") ? vm["kr-table"].as<std::string>() : data.string("kr_table");
     const KrTable table = KrTable::fromFile(tablePath);
     const LinearBicycleParams linear = LinearBicycleParams::fromParams(data.child("linear_bicycle"));
@@ -193,6 +200,11 @@ int main(int argc, char** argv) {
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
+    const SceneDescription scene = SceneDescription::fromFile(
+        "scenes/ch8_maneuvers.json", standardRegistry(),
+        {{"vehicle.data", vehicleData},
+         {"plugins.rear_control.kr_table", resolveDataPath(tablePath)},
+         {"plugins.rear_control.linear_bicycle", data.child("linear_bicycle").json()}});
 
     const std::string reading = vm.count("lane-change-length") ? vm["lane-change-length"].as<std::string>()
                                                                  : data.stringOr("lane_change_length", "full");
@@ -215,6 +227,7 @@ int main(int argc, char** argv) {
       }
       sc.path = makeReferencePath(ParamReader::fromJson(sc.path_json, r.at("path")));
       sc.gains = PathControlParams::fromParams(r.child("gains"));
+      sc.gains_json = r.child("gains").json();
       for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
         sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
       sc.rear = r.has("rear_steer_gains") ? RearSteerParams::fromParams(r.child("rear_steer_gains")) : rearDefault;
@@ -248,7 +261,7 @@ int main(int argc, char** argv) {
       study::writePathCsv(refCsv, *sc.path, sc.speed_m_s * 1.0, sc.speed_m_s * 2.0);
       std::vector<std::pair<std::string, std::string>> csvs;
       for (const auto& st : strategies) {
-        RunResult r = runOne(vp, sc, st, linear, table, base, out);
+        RunResult r = runOne(scene, sc, st, base, out);
         r.summary["path"] = sc.path_json;
         r.summary["path_peak_lateral_acceleration_m_s2"] = sc.path_peak_ay;
         r.summary["gains"] = {{"k1_rad_per_s2_per_m", sc.gains.k1_rad_per_s2_per_m},

@@ -12,6 +12,8 @@
 #include "study.h"
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/core/scene_file.h"
+#include "vdyn/speed/speed_hold.h"
+#include "vdyn/vehicles/fourws.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 namespace vdyn::study {
@@ -23,6 +25,8 @@ struct Ch3Case {
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
   TransientSettings transient;       ///< the scene's "analysis" (a transient)
   SimulationSettings sim;            ///< transient.simulation()
+  /// "constrained" or "reduced" overrides the vehicle file's corner_model; empty keeps it.
+  std::string corner_model;
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
   /// --integrator, --accuracy.
@@ -30,7 +34,10 @@ struct Ch3Case {
     opts.add_options()("speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
         "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
         "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
-        "t-end-s", po::value<double>(), tEndHelp.c_str());
+        "t-end-s", po::value<double>(), tEndHelp.c_str())(
+        "corner-model", po::value<std::string>(),
+        "constrained (loops closed by constraints, the reference) or reduced (loops solved in the tree); "
+        "default: the vehicle file's corner_model");
     addIntegratorOptions(opts);
   }
 
@@ -52,6 +59,11 @@ struct Ch3Case {
     if (has("t-end-s")) o.push_back({"analysis.t_end_s", requirePositive((*vm)["t-end-s"].as<double>(), "--t-end-s")});
     if (has("integrator")) o.push_back({"analysis.integrator.method", (*vm)["integrator"].as<std::string>()});
     if (has("accuracy")) o.push_back({"analysis.integrator.accuracy", (*vm)["accuracy"].as<double>()});
+    std::string cornerModel;
+    if (has("corner-model")) {
+      cornerModel = checkedCornerModel((*vm)["corner-model"].as<std::string>());
+      o.push_back({"vehicle.overrides.corner_model", cornerModel});
+    }
     Ch3Case c{SceneDescription::fromFile(sceneFile, standardRegistry(), o)};
     const Json& j = c.scene.json();
     const std::string where = c.scene.path();
@@ -69,6 +81,7 @@ struct Ch3Case {
     c.transient = TransientSettings::fields().read(
         ParamReader::fromJson(j.at("analysis"), where + " analysis"));
     c.sim = c.transient.simulation();
+    c.corner_model = cornerModel;
     requirePositive(c.speed_m_s, "--speed-m-s");
     requirePositive(c.sim.t_end_s, "--t-end-s");
     return c;
@@ -78,8 +91,37 @@ struct Ch3Case {
   double settledTime() const { return steer_start_s + steer_duration_s; }
 
   /// The scene: the vehicle with its steering ("front_steer", "rear_steer")
-  /// and speed hold ("speed_hold"), built by the scene loader.
-  BuiltScene build() const { return scene.build(); }
+  /// and speed hold ("speed_hold"), built by the scene loader. `cornerModel`
+  /// (if not empty) overrides corner_model.
+  BuiltScene build(const std::string& cornerModel = "") const {
+    if (cornerModel.empty()) return scene.build();
+    return scene.withOverride("vehicle.overrides.corner_model", checkedCornerModel(cornerModel)).build();
+  }
+
+  /// The same vehicle as a concrete FourWsVehicle, for code that needs its
+  /// C++ API (ch3_work_precision maps the reduced model's state from the
+  /// constrained one): the scene's vehicle data and the values read from it.
+  std::unique_ptr<FourWsVehicle> buildVehicle(const std::string& cornerModel = "") const {
+    const Json& v = scene.json().at("vehicle");
+    Json data = ParamReader::fromFile(scene.resolve(v.at("data").get<std::string>())).json();
+    if (v.contains("overrides")) data.merge_patch(v.at("overrides"));
+    FourWsParams p = FourWsParams::fromParams(ParamReader::fromJson(data, scene.path() + " vehicle"));
+    if (!corner_model.empty()) p.corner_model = corner_model;
+    if (!cornerModel.empty()) p.corner_model = checkedCornerModel(cornerModel);
+    auto car = std::make_unique<FourWsVehicle>(p);
+    car->addAxleSteering("front_steer", true,
+                         std::make_shared<SmoothStepCommand>(0, front_rad, steer_start_s, steer_duration_s));
+    car->addAxleSteering("rear_steer", false,
+                         std::make_shared<SmoothStepCommand>(0, rear_rad, steer_start_s, steer_duration_s));
+    car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", speed_m_s));
+    return car;
+  }
+
+  static std::string checkedCornerModel(const std::string& m) {
+    if (m != "constrained" && m != "reduced")
+      throw Error("--corner-model must be constrained or reduced, got '" + m + "'");
+    return m;
+  }
 };
 
 }  // namespace vdyn::study

@@ -10,7 +10,8 @@
 #include <fstream>
 
 #include "study.h"
-#include "vdyn/speed/speed_hold.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
 #include "vdyn/vehicles/fourws.h"
@@ -51,13 +52,19 @@ int main(int argc, char** argv) {
     const double ratio = requireFinite(vm["rear-ratio"].as<double>(), "--rear-ratio");
     const std::string out = study::outputDir(vm, "steady_sweep");
 
-    FourWsVehicle car(FourWsParams::fromFile(vm["data"].as<std::string>()));
-    auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
-    car.addAxleSteering("front_steer", true, front);
-    car.addAxleSteering("rear_steer", false, rear);
-    const auto& hold = static_cast<const SpeedHoldPlugin&>(
-        car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", speeds.front())));
-    const Scene& sc = car.getScene();
+    // The composition is the scene (scenes/steady_sweep.json: held front and
+    // rear steering, speed hold), built as `vdyn run` does; speed and angles
+    // change through the plugins' adjustables (continuation, no rebuild).
+    const BuiltScene built =
+        SceneDescription::fromFile("scenes/steady_sweep.json", standardRegistry(),
+                                   {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())},
+                                    {"vehicle.initial_speed_m_s", speeds.front()},
+                                    {"plugins.speed_hold.speed_m_s", speeds.front()}})
+            .build();
+    const Scene& sc = built.scene();
+    const Plugin& front = *sc.findPlugin<Plugin>("front_steer");
+    const Plugin& rear = *sc.findPlugin<Plugin>("rear_steer");
+    const Plugin& hold = *sc.findPlugin<Plugin>("speed_hold");
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
 
     const std::string csv = out + "/sweep.csv";
@@ -74,16 +81,16 @@ int main(int argc, char** argv) {
     for (double kr : {0.0, ratio}) {
       Json rows = Json::array();
       for (double U : speeds) {
-        SimTK::State start = car.makeInitialState(U);
-        hold.setSpeed(start, U);
+        SimTK::State start = built.vehicle->makeInitialState(U);
+        hold.setAdjustable(start, "speed_m_s", U);
         const auto ts = std::chrono::steady_clock::now();
         // The branch starts at straight running (0 deg: the initial state is
         // its solution) and follows the front angle up.
         std::vector<double> values = {0.0};
         values.insert(values.end(), fronts.begin(), fronts.end());
-        auto pts = followSteadyState(solver, start, values, [&](SimTK::State&, double fdeg) {
-          front->setAngle(fdeg * deg);
-          rear->setAngle(kr * fdeg * deg);
+        auto pts = followSteadyState(solver, start, values, [&](SimTK::State& st, double fdeg) {
+          front.setAdjustable(st, "angle_rad", fdeg * deg);
+          rear.setAdjustable(st, "angle_rad", kr * fdeg * deg);
         });
         if (!pts.front().converged) throw Error("steady_sweep: straight running at " + formatValue(U) + " m/s did not converge: " + pts.front().failure);
         pts.erase(pts.begin());

@@ -1,5 +1,6 @@
 // vdyn list [KIND]: every registered name by kind, with its keys, units,
 // defaults and one-line meaning (the field tables the loaders read with).
+#include <algorithm>
 #include <cstdio>
 
 #include "command.h"
@@ -22,8 +23,13 @@ int listCommand(const std::vector<std::string>& args) {
     for (const auto& type : registry.known(kind)) {
       const TypeInfo& info = registry.info(kind, type);
       std::printf("  %s%s%s\n", type.c_str(), info.summary.empty() ? "" : " -- ", info.summary.c_str());
+      int kw = 4, dw = 7;
+      for (const auto& f : info.fields) {
+        kw = std::max(kw, static_cast<int>(f.key.size()));
+        dw = std::max(dw, static_cast<int>(std::min<std::size_t>(f.default_value.size(), 24)));
+      }
       for (const auto& f : info.fields)
-        std::printf("      %-34s %-10s %-14s %s\n", f.key.c_str(), f.unit.empty() ? "1" : f.unit.c_str(),
+        std::printf("      %-*s  %-10s %-*s  %s\n", kw, f.key.c_str(), f.unit.empty() ? "1" : f.unit.c_str(), dw,
                     f.default_value.c_str(), f.meaning.c_str());
     }
     std::printf("\n");

@@ -54,7 +54,8 @@ class FourWsSceneVehicle : public Vehicle {
   Json DoDescribe(const SimTK::State& s) const override {
     return {{"total_mass_kg", car_.totalMass()},
             {"dof", car_.degreesOfFreedom(s)},
-            {"assembly_max_body_move_m", assembly_.max_move_m}};
+            {"assembly_max_body_move_m", assembly_.max_move_m},
+            {"corner_model", car_.params().corner_model}};
   }
 
  private:

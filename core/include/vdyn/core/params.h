@@ -26,16 +26,22 @@ using Json = nlohmann::json;
 /// Reads and parses a JSON file; throws Error naming the file on I/O or syntax errors.
 Json readJsonFile(const std::string& path);
 
+/// The folders a data-file name is looked up in when it is not an existing
+/// path, in order: each folder of the environment variable VDYN_DATA_PATH
+/// (':'-separated, read at every call), then the installed data folder
+/// <prefix>/share/vdyn/data, found from the location of the vdyn_core library
+/// (so an installed tree works wherever it is moved), or, when that folder
+/// does not exist (a build tree), the source tree's vehicles/data.
+std::vector<std::string> dataSearchPath();
+
 /// Resolves a data-file name: an existing path is used as is, otherwise it is
-/// looked up along dataSearchPath().
+/// looked up along dataSearchPath(); throws Error naming the file and every
+/// folder looked in.
 std::string resolveDataPath(const std::string& name);
 /// Resolves a file name written inside another file (`namingFile`): an absolute
 /// path as is; a relative one first in the folder of `namingFile`, then along
 /// dataSearchPath(). Throws Error naming `namingFile` and every folder tried.
 std::string resolveDataPath(const std::string& name, const std::string& namingFile);
-/// The data search path: the folders of the VDYN_DATA_PATH environment variable
-/// (':'-separated, in order), then the project's data folder (VDYN_DATA_DIR).
-std::vector<std::string> dataSearchPath();
 
 class ParamReader {
  public:
