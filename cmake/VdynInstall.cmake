@@ -46,6 +46,9 @@ foreach(t IN LISTS VDYN_EXPORTED_LIBRARIES)
   # Include folders of the source tree: installed under P/include (every public
   # folder holds vdyn/<part>/...), used from the source tree by this build.
   get_target_property(dirs ${t} INTERFACE_INCLUDE_DIRECTORIES)
+  if(NOT dirs)
+    set(dirs "")
+  endif()
   set(wrapped "")
   foreach(d IN LISTS dirs)
     if(d MATCHES "^(${CMAKE_SOURCE_DIR}|${CMAKE_BINARY_DIR})")
@@ -72,10 +75,8 @@ if(TARGET vdyn)
   install(TARGETS vdyn EXPORT vdynTargets RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
 endif()
 
+# The data files, with the chapter scenes (data/scenes/).
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/vehicles/data/ DESTINATION ${VDYN_INSTALL_DATADIR})
-if(EXISTS ${CMAKE_SOURCE_DIR}/scenes)
-  install(DIRECTORY ${CMAKE_SOURCE_DIR}/scenes/ DESTINATION ${CMAKE_INSTALL_DATADIR}/vdyn/scenes)
-endif()
 
 set(VDYN_INSTALL_CMAKEDIR ${CMAKE_INSTALL_LIBDIR}/cmake/vdyn)
 install(EXPORT vdynTargets NAMESPACE vdyn:: DESTINATION ${VDYN_INSTALL_CMAKEDIR})

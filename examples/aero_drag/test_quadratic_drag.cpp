@@ -31,6 +31,7 @@ int main() {
     sim.integrator.accuracy = 1e-8;
     vdyn::simulate(scene, s, sim);
 
+    scene.getSystem().realize(s, SimTK::Stage::Velocity);  // simulate() leaves the final state unrealized
     const double c = p.coefficient_kg_per_m();
     const double v = free.getBodyOriginVelocity(s)[0];
     const double closed = v0 / (1 + c * v0 * t_end / m);

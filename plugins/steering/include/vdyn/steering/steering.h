@@ -208,9 +208,6 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
  protected:
   void DoAddTo(Scene& scene) override;
   void DoInitialize(const Scene& scene, SimTK::State& state) const override;
-  /// "angle_rad" for a plugin on a HoldCommand (HoldCommand::setAngle).
-  std::vector<std::string> DoGetAdjustables() const override;
-  void DoSetAdjustable(SimTK::State& state, const std::string& key, double value) const override;
   // SteeringActuator
   bool DoIsStateDriven() const override { return stateDriven_; }
   void DoSetAccelerationLaw(std::shared_ptr<const SteeringLaw> law) override;
@@ -218,6 +215,9 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
   double DoGetAngle(const SimTK::State& s) const override;
   double DoGetRate(const SimTK::State& s) const override;
   double DoCalcAcceleration(const SimTK::State& s) const override;
+  /// "angle_rad" for a plugin on a HoldCommand (HoldCommand::setAngle).
+  std::vector<std::string> DoGetAdjustables() const override;
+  void DoSetAdjustable(SimTK::State& state, const std::string& key, double value) const override;
 
  private:
   struct LawSlot {
