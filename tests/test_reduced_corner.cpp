@@ -11,7 +11,7 @@
 #include "test_util.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/sensitivity/sensitivity.h"
-#include "vdyn/sensitivity/vehicle_designs.h"
+#include "vdyn/vehicles/vehicle_designs.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/vehicles/fourws.h"
