@@ -60,7 +60,9 @@ std::unique_ptr<Plugin> PluginRegistry::create(PluginKind kind, const std::strin
     throw Error(where + ": unknown " + toString(kind) + " plugin '" + type + "'; known: " +
                 (list.empty() ? "(none)" : list));
   }
-  return it->second(spec);
+  std::unique_ptr<Plugin> plugin = it->second(spec);
+  spec.params.requireAllKeysRead();  // a key the plugin never asked for is an error
+  return plugin;
 }
 
 // ---------------------------------------------------------------------------

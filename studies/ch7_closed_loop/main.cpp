@@ -79,16 +79,23 @@ int main(int argc, char** argv) {
                                  "closed-loop lane change and J-turn of the nonlinear bicycle (7.3)", argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
     const BicycleParams bp = BicycleParams::fromFile(data.string("bicycle_data"));
-    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
-    requirePositive(U0, "--speed-m-s");
+    const double U0 = study::checkSpeed(study::optionOr(vm, "speed-m-s", data, "speed_m_s"));
     SimulationSettings base;
-    base.report_interval_s = data.number("report_interval_s");
+    base.report_interval_s = requirePositive(data.number("report_interval_s"), data.at("report_interval_s"));
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
     const std::string out = study::outputDir(vm, "ch7_closed_loop");
     const auto wall0 = std::chrono::steady_clock::now();
 
+    for (const char* name : {"lane_change", "j_turn"}) {  // read and check everything before the first run
+      const ParamReader m = data.child(name);
+      makeReferencePath(m.child("path"));
+      PathControlParams::fromParams(m.child("gains"));
+      study::checkRunTimes({m.number("t_end_s"), m.at("t_end_s")},
+                           {base.report_interval_s, data.at("report_interval_s")});
+    }
+    data.requireAllKeysRead();
     std::vector<RunResult> runs;
     for (const char* name : {"lane_change", "j_turn"}) runs.push_back(runOne(bp, U0, data.child(name), base, name, out));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -70,10 +70,9 @@ int main(int argc, char** argv) {
                                  argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
     const BicycleParams bp = BicycleParams::fromFile(data.string("bicycle_data"));
-    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
-    requirePositive(U0, "--speed-m-s");
+    const double U0 = study::checkSpeed(study::optionOr(vm, "speed-m-s", data, "speed_m_s"));
     SimulationSettings base;
-    base.report_interval_s = data.number("report_interval_s");
+    base.report_interval_s = requirePositive(data.number("report_interval_s"), data.at("report_interval_s"));
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
@@ -83,8 +82,17 @@ int main(int argc, char** argv) {
     std::vector<RunResult> runs;
     const ParamReader lc = data.child("lane_change");
     const double t0 = lc.number("start_time_s"), ramp = lc.number("ramp_s"), hold = lc.number("hold_s"),
-                 cross = lc.number("crossover_s");
-    for (double d : lc.numbers("amplitudes_rad")) {
+                 cross = lc.number("crossover_s"), lcEnd = lc.number("t_end_s");
+    const std::vector<double> amplitudes = lc.numbers("amplitudes_rad");
+    for (std::size_t i = 0; i < amplitudes.size(); ++i)
+      study::checkSteerAngle({amplitudes[i], lc.at("amplitudes_rad") + "[" + std::to_string(i) + "]"}, false);
+    const ParamReader ci = data.child("circle");
+    const double ciAngle = study::checkSteerAngle({ci.number("angle_rad"), ci.at("angle_rad")}, false);
+    const double ciStart = ci.number("start_time_s"), ciRamp = ci.number("ramp_s"), ciEnd = ci.number("t_end_s");
+    study::checkRunTimes({lcEnd, lc.at("t_end_s")}, {base.report_interval_s, data.at("report_interval_s")});
+    study::checkRunTimes({ciEnd, ci.at("t_end_s")}, {base.report_interval_s, data.at("report_interval_s")});
+    data.requireAllKeysRead();
+    for (double d : amplitudes) {
       // Figure 7.2a: up, hold, across, hold, back.
       auto cmd = std::make_shared<StepSequenceCommand>(
           0.0, std::vector<StepSequenceCommand::Step>{{t0, ramp, d},
@@ -92,13 +100,10 @@ int main(int argc, char** argv) {
                                                        {t0 + ramp + hold + cross + hold, ramp, d}});
       char name[64];
       std::snprintf(name, sizeof name, "lane_change_%gdeg", std::round(d * 180 / SimTK::Pi * 10) / 10);
-      runs.push_back(runOne(bp, U0, cmd, lc.number("t_end_s"), base, name, out));
+      runs.push_back(runOne(bp, U0, cmd, lcEnd, base, name, out));
     }
-    const ParamReader ci = data.child("circle");
-    runs.push_back(runOne(bp, U0,
-                          std::make_shared<SmoothStepCommand>(0.0, ci.number("angle_rad"), ci.number("start_time_s"),
-                                                              ci.number("ramp_s")),
-                          ci.number("t_end_s"), base, "circle", out));
+    runs.push_back(runOne(bp, U0, std::make_shared<SmoothStepCommand>(0.0, ciAngle, ciStart, ciRamp), ciEnd, base,
+                          "circle", out));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
     Json list = Json::array();

@@ -203,10 +203,10 @@ int main(int argc, char** argv) {
       Scenario sc;
       sc.id = r.string("id");
       sc.description = r.string("description");
-      sc.speed_m_s = requirePositive(r.number("speed_m_s"), r.at("speed_m_s"));
+      sc.speed_m_s = study::checkSpeed({r.number("speed_m_s"), r.at("speed_m_s")});
       sc.t_end_s = requirePositive(r.number("t_end_s"), r.at("t_end_s"));
       sc.abort_path_error_m = requirePositive(data.number("abort_path_error_m"), data.at("abort_path_error_m"));
-      sc.path_json = r.child("path").json();
+      sc.path_json = r.raw("path");
       if (reading == "half" && sc.path_json.value("type", "") == "lane_change") {
         // The seed's distance is each half: the lane change spans twice it.
         const double length = sc.path_json.at("length_m").get<double>();
@@ -218,8 +218,10 @@ int main(int argc, char** argv) {
       for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
         sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
       sc.rear = r.has("rear_steer_gains") ? RearSteerParams::fromParams(r.child("rear_steer_gains")) : rearDefault;
+      study::checkRunTimes({sc.t_end_s, r.at("t_end_s")}, {base.report_interval_s, data.at("report_interval_s")});
       scenarios.push_back(sc);
     }
+    data.requireAllKeysRead();
     if (vm.count("scenario")) {
       std::vector<Scenario> chosen;
       for (const auto& id : splitList(vm["scenario"].as<std::string>())) {

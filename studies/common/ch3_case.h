@@ -33,23 +33,29 @@ struct Ch3Case {
   }
 
   /// The data file's case; options in `vm` (if given) override it.
+  /// Every value is checked against its physical range and named as the user
+  /// gave it (the option, or the data file's key path); a key of the data file
+  /// that is not read is an error (ParamReader::requireAllKeysRead).
   static Ch3Case fromData(const ParamReader& data, const po::variables_map* vm = nullptr) {
     const double deg = SimTK::Pi / 180;
-    auto has = [&](const char* k) { return vm && vm->count(k); };
+    static const po::variables_map none;
+    const po::variables_map& v = vm ? *vm : none;
     Ch3Case c;
     c.vehicle_data = data.string("vehicle_data");
-    c.speed_m_s = has("speed-m-s") ? (*vm)["speed-m-s"].as<double>() : data.number("speed_m_s");
-    c.front_rad = has("front-deg") ? (*vm)["front-deg"].as<double>() * deg : data.number("front_angle_rad");
-    c.rear_rad = has("rear-deg") ? (*vm)["rear-deg"].as<double>() * deg : data.number("rear_angle_rad");
-    c.steer_start_s = data.number("steer_start_time_s");
-    c.steer_duration_s = data.number("steer_duration_s");
+    c.speed_m_s = checkSpeed(optionOr(v, "speed-m-s", data, "speed_m_s"));
+    c.front_rad = checkSteerAngle(optionOr(v, "front-deg", data, "front_angle_rad", deg), true);
+    c.rear_rad = checkSteerAngle(optionOr(v, "rear-deg", data, "rear_angle_rad", deg), true);
+    c.steer_start_s = requireNonNegative(data.number("steer_start_time_s"), data.at("steer_start_time_s"));
+    c.steer_duration_s = requirePositive(data.number("steer_duration_s"), data.at("steer_duration_s"));
     const ParamReader simData = data.child("simulation");
-    c.sim.t_end_s = has("t-end-s") ? (*vm)["t-end-s"].as<double>() : simData.number("t_end_s");
-    c.sim.report_interval_s = simData.number("report_interval_s");
+    const Given tEnd = optionOr(v, "t-end-s", simData, "t_end_s");
+    const Given dt{simData.number("report_interval_s"), simData.at("report_interval_s")};
+    checkRunTimes(tEnd, dt);
+    c.sim.t_end_s = tEnd.value;
+    c.sim.report_interval_s = dt.value;
     c.sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
     if (vm) applyIntegratorOptions(*vm, c.sim.integrator);
-    requirePositive(c.speed_m_s, "--speed-m-s");
-    requirePositive(c.sim.t_end_s, "--t-end-s");
+    data.requireAllKeysRead();
     return c;
   }
 

@@ -1,6 +1,7 @@
 #include "study.h"
 
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <memory>
 #include <cstdlib>
@@ -8,6 +9,8 @@
 #include <fstream>
 #include <iostream>
 #include <unistd.h>
+
+#include "vdyn/core/file_io.h"
 
 namespace vdyn::study {
 
@@ -30,7 +33,15 @@ po::variables_map parse(const std::string& study, const std::string& summary, in
       "out", po::value<std::string>(), "output folder (default: results/<study>/ in the repository)");
   po::variables_map vm;
   try {
-    po::store(po::parse_command_line(argc, argv, options), vm);
+    const po::parsed_options parsed = po::command_line_parser(argc, argv).options(options).run();
+    // A stray word (a value without its option, a misspelled "-out") is an
+    // error, never silently ignored.
+    for (const auto& o : parsed.options)
+      if (o.position_key >= 0 || o.unregistered)
+        throw Error("bad command line: unexpected argument '" +
+                    (o.original_tokens.empty() ? o.string_key : o.original_tokens.front()) +
+                    "' (options start with --; see --help)");
+    po::store(parsed, vm);
     po::notify(vm);
   } catch (const po::error& e) {
     throw Error(std::string("bad command line: ") + e.what() + " (see --help)");
@@ -51,9 +62,65 @@ std::string outputDir(const po::variables_map& vm, const std::string& study) {
 }
 
 void writeJson(const std::string& path, const Json& j) {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write '" + path + "'");
-  out << j.dump(2) << '\n';
+  std::string text;
+  try {
+    text = j.dump(2) + "\n";
+  } catch (const nlohmann::json::exception& e) {
+    throw Error("cannot write '" + path + "': " + e.what());
+  }
+  writeFileAtomic(path, text);
+}
+
+void writeFileAtomic(const std::string& path, const std::string& text) { vdyn::writeFileAtomic(path, text); }
+
+Given optionOr(const po::variables_map& vm, const std::string& option, const ParamReader& data, const std::string& key,
+               double scale) {
+  if (vm.count(option)) {
+    data.has(key);  // the data file's value is overridden, not unknown
+    return {requireFinite(vm[option].as<double>(), "--" + option) * scale, "--" + option};
+  }
+  return {data.number(key), data.at(key)};
+}
+
+Given optionOr(const po::variables_map& vm, const std::string& option, double fallback,
+               const std::string& fallbackName, double scale) {
+  if (vm.count(option)) return {requireFinite(vm[option].as<double>(), "--" + option) * scale, "--" + option};
+  return {fallback, fallbackName};
+}
+
+double checkSpeed(const Given& g, bool allowZero) {
+  requireFinite(g.value, g.name);
+  if (!(allowZero ? g.value >= 0 : g.value > 0) || g.value > 100)
+    throw Error(g.name + " must lie in " + (allowZero ? "[0" : "(0") + ", 100] m/s, got " + formatValue(g.value));
+  return g.value;
+}
+
+double checkSteerAngle(const Given& g, bool optionInDeg) {
+  const double deg = SimTK::Pi / 180;
+  const bool option = g.name.rfind("--", 0) == 0;
+  if (option && optionInDeg) {
+    requireInRange(g.value / deg, -45, 45, g.name);
+  } else {
+    requireFinite(g.value, g.name);
+    if (std::abs(g.value) > 45 * deg)
+      throw Error(g.name + " must lie in [-0.785398, 0.785398] rad (+-45 deg), got " + formatValue(g.value));
+  }
+  return g.value;
+}
+
+void checkRunTimes(const Given& tEnd, const Given& dt) {
+  requireFinite(tEnd.value, tEnd.name);
+  if (!(tEnd.value > 0) || tEnd.value > 1e5)
+    throw Error(tEnd.name + " must lie in (0, 1e5] s, got " + formatValue(tEnd.value));
+  requireFinite(dt.value, dt.name);
+  if (!(dt.value > 0)) throw Error(dt.name + " must be positive, got " + formatValue(dt.value));
+  if (dt.value > tEnd.value)
+    throw Error(dt.name + " (" + formatValue(dt.value) + " s) must not exceed the run's end time " + tEnd.name + " (" +
+                formatValue(tEnd.value) + " s)");
+  if (tEnd.value / dt.value > 1e6)
+    throw Error(dt.name + " = " + formatValue(dt.value) + " s gives " + formatValue(std::ceil(tEnd.value / dt.value)) +
+                " samples over " + formatValue(tEnd.value) + " s (limit 1e6; " + dt.name + " must be at least " +
+                formatValue(tEnd.value / 1e6) + " s)");
 }
 
 static std::string quote(const std::string& s) {
@@ -119,13 +186,19 @@ void plot(const std::vector<PlotSpec>& plots) {
 bool interactive() { return isatty(fileno(stderr)); }
 
 std::function<void(const SimTK::State&)> progress(const std::string& label, double tEnd) {
-  if (!interactive()) return {};
-  auto last = std::make_shared<std::chrono::steady_clock::time_point>(std::chrono::steady_clock::now());
-  return [label, tEnd, last](const SimTK::State& s) {
+  const bool tty = interactive();
+  const auto start = std::chrono::steady_clock::now();
+  auto last = std::make_shared<std::chrono::steady_clock::time_point>(start);
+  return [label, tEnd, last, tty, start](const SimTK::State& s) {
     const auto now = std::chrono::steady_clock::now();
-    if (std::chrono::duration<double>(now - *last).count() < 0.2) return;
+    if (std::chrono::duration<double>(now - *last).count() < (tty ? 0.2 : 10.0)) return;
     *last = now;
-    std::fprintf(stderr, "\r%s: t = %.2f / %.2f s", label.c_str(), s.getTime(), tEnd);
+    if (tty) {
+      std::fprintf(stderr, "\r%s: t = %.2f / %.2f s", label.c_str(), s.getTime(), tEnd);
+    } else {  // a log: one line every 10 s of wall time
+      std::fprintf(stderr, "%s: t = %.3f / %.3f s after %.0f s wall time\n", label.c_str(), s.getTime(), tEnd,
+                   std::chrono::duration<double>(now - start).count());
+    }
     std::fflush(stderr);
   };
 }
@@ -142,7 +215,12 @@ void addIntegratorOptions(po::options_description& options) {
 
 void applyIntegratorOptions(const po::variables_map& vm, IntegratorSettings& settings) {
   if (vm.count("integrator")) settings.method = vm["integrator"].as<std::string>();
-  if (vm.count("accuracy")) settings.accuracy = vm["accuracy"].as<double>();
+  if (vm.count("accuracy")) {
+    settings.accuracy = requireFinite(vm["accuracy"].as<double>(), "--accuracy");
+    if (!(settings.accuracy > 0 && settings.accuracy < 1))
+      throw Error("--accuracy must lie in (0, 1), got " + formatValue(settings.accuracy));
+  }
+  settings.validate();
 }
 
 }  // namespace vdyn::study

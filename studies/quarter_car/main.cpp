@@ -25,13 +25,14 @@ int main(int argc, char** argv) {
     const QuarterCarParams params = QuarterCarParams::fromParams(data);
     SimulationSettings sim;
     const ParamReader simData = data.child("simulation");
-    sim.t_end_s = simData.number("t_end_s");
-    sim.report_interval_s = simData.number("report_interval_s");
+    const study::Given tEnd = study::optionOr(vm, "t-end-s", simData, "t_end_s");
+    const study::Given dt = study::optionOr(vm, "report-interval-s", simData, "report_interval_s");
+    study::checkRunTimes(tEnd, dt);
+    sim.t_end_s = tEnd.value;
+    sim.report_interval_s = dt.value;
     sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
     study::applyIntegratorOptions(vm, sim.integrator);
-    if (vm.count("t-end-s")) sim.t_end_s = vm["t-end-s"].as<double>();
-    if (vm.count("report-interval-s")) sim.report_interval_s = vm["report-interval-s"].as<double>();
-    requirePositive(sim.t_end_s, "--t-end-s");
+    data.requireAllKeysRead();
     const std::string out = study::outputDir(vm, "quarter_car");
 
     QuarterCar car(params);

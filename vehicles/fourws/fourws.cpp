@@ -35,6 +35,7 @@ FourWsParams FourWsParams::fromParams(const ParamReader& r) {
   p.tire = TireParams::fromParams(tire.child("params"));
   if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
   p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
+  r.requireAllKeysRead();
   p.validate();
   return p;
 }

@@ -32,6 +32,7 @@ PathControlParams PathControlParams::fromParams(const ParamReader& r) {
   p.acceleration_estimate = r.stringOr("acceleration_estimate", p.acceleration_estimate);
   p.acceleration_lag_s = r.numberOr("acceleration_lag_s", p.acceleration_lag_s);
   p.tracked_point_m = r.vec3Or("tracked_point_m", p.tracked_point_m);
+  r.requireAllKeysRead();
   p.validate();
   return p;
 }

@@ -26,6 +26,7 @@ KrTable KrTable::fromParams(const ParamReader& r) {
   KrTable t;
   for (const auto& row : r.array("fit"))
     t.rows.push_back({row.number("speed_m_s"), row.number("c1"), row.number("c2_per_deg2")});
+  r.requireAllKeysRead();
   t.validate(r.at("fit"));
   return t;
 }
@@ -101,6 +102,7 @@ RearSteerParams RearSteerParams::fromParams(const ParamReader& r) {
   RearSteerParams p;
   p.g1_per_s2 = r.number("g1_per_s2");
   p.g2_per_s = r.number("g2_per_s");
+  r.requireAllKeysRead();
   p.validate();
   return p;
 }

@@ -58,19 +58,23 @@ SteerCommandValue StepSequenceCommand::DoCalc(double t) const {
 
 std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r) {
   const std::string type = r.string("type");
-  if (type == "hold") return std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
-  if (type == "smooth_step") {
+  std::shared_ptr<const SteeringCommand> cmd;
+  if (type == "hold") {
+    cmd = std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
+  } else if (type == "smooth_step") {
     const double d0 = r.numberOr("initial_rad", 0.0);
-    return std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
-                                               r.number("duration_s"));
-  }
-  if (type == "steps") {
+    cmd = std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
+                                              r.number("duration_s"));
+  } else if (type == "steps") {
     std::vector<StepSequenceCommand::Step> steps;
     for (const auto& k : r.array("steps"))
       steps.push_back({k.number("start_time_s"), k.number("duration_s"), k.number("change_rad")});
-    return std::make_shared<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+    cmd = std::make_shared<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+  } else {
+    throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step, steps");
   }
-  throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step, steps");
+  r.requireAllKeysRead();
+  return cmd;
 }
 
 // ---------------------------------------------------------------------------
@@ -316,8 +320,13 @@ void SteeringPlugin::addStateDriven(Scene& scene) {
   steer_.setDefaultAngle(state_.initial_angle_rad);
   const auto slot = slot_;
   const std::string who = name();
-  SimTK::Motion::Custom(steer_, new SteeringLawMotion([slot, who](const SimTK::State& s) {
-    if (!slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
+  // The Motion belongs to the steer body, and the law holds handles to that
+  // body: a strong reference here would be a cycle that keeps the whole Simbody
+  // system alive (LeakSanitizer). The plugin (owned by the scene) owns the slot.
+  const std::weak_ptr<LawSlot> weakSlot = slot_;
+  SimTK::Motion::Custom(steer_, new SteeringLawMotion([weakSlot, who](const SimTK::State& s) {
+    const auto slot = weakSlot.lock();
+    if (!slot || !slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
     return slot->law->calcAcceleration(s);
   }));
   scene.addBody(name() + ".steer", steer_);
@@ -384,7 +393,7 @@ void registerSteeringPlugins(PluginRegistry& registry) {
         }
       }
     } else {
-      const Json& j = spec.params.json().at("knuckles");
+      const Json& j = spec.params.raw("knuckles");
       for (const auto& k : j) knuckles.push_back(k.get<std::string>());
     }
     const SimTK::UnitVec3 spin(spec.params.vec3Or("spin_axis", Vec3(0, 1, 0)));

@@ -30,6 +30,7 @@ LinearBicycleParams LinearBicycleParams::fromParams(const ParamReader& r) {
   p.rear_axle_to_com_m = r.number("rear_axle_to_com_m");
   p.front_cornering_stiffness_N_per_rad = r.number("front_cornering_stiffness_N_per_rad");
   p.rear_cornering_stiffness_N_per_rad = r.number("rear_cornering_stiffness_N_per_rad");
+  r.requireAllKeysRead();
   try {
     p.validate();
   } catch (const Error& e) {
@@ -154,6 +155,7 @@ std::vector<RatioFit> readRatioTable(const std::string& path) {
     fits.push_back(f);
   }
   if (fits.empty()) throw Error(r.at("fit") + ": no rows");
+  r.requireAllKeysRead();
   return fits;
 }
 

@@ -60,11 +60,7 @@ const std::vector<TireParams::Field>& TireParams::fields() {
 TireParams TireParams::fromParams(const ParamReader& r) {
   TireParams p;
   for (const auto& [key, member] : fields()) p.*member = r.numberOr(key, p.*member);
-  for (auto it = r.json().begin(); it != r.json().end(); ++it) {
-    bool known = false;
-    for (const auto& f : fields()) known |= (it.key() == f.first);
-    if (!known && it.key().rfind("_", 0) != 0) throw Error(r.at(it.key()) + ": unknown tire parameter");
-  }
+  r.requireAllKeysRead();  // an unknown key is an error, with the nearest of fields() as a hint
   p.validate(r.where());
   return p;
 }

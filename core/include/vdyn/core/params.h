@@ -21,13 +21,22 @@ namespace vdyn {
 
 using Json = nlohmann::json;
 
-/// Reads and parses a JSON file; throws Error naming the file on I/O or syntax errors.
+/// Reads and parses a JSON file (// comments allowed); throws Error naming the
+/// file, and where it can the line, column and key path, on I/O or syntax
+/// errors, an empty file, a number out of range (1e999) or a duplicate key.
 Json readJsonFile(const std::string& path);
+/// Parses JSON text; `name` names the source in messages (as readJsonFile).
+Json parseJsonText(const std::string& text, const std::string& name);
 
 /// Resolves a data-file name: an existing path is used as is, otherwise it is
 /// looked up in the project's data folder (vehicles/data).
 std::string resolveDataPath(const std::string& name);
 
+/// Typed access to one object of a data file. Every accessor (has, number,
+/// ...Or, child, array, raw) records the key it was asked for, present or not,
+/// so requireAllKeysRead() can reject the keys nobody asked for: a misspelled
+/// or unknown key is an error, never silently ignored. Copies and children
+/// share the record. Keys starting with '_' are comments and never required.
 class ParamReader {
  public:
   /// `where` names the source in messages (file name, optionally key path).
@@ -49,15 +58,35 @@ class ParamReader {
   int integer(const std::string& key) const;
   ParamReader child(const std::string& key) const;
   std::vector<ParamReader> array(const std::string& key) const;
+  /// The raw value of a required key; the caller takes over checking it (the
+  /// key and everything under it count as read).
+  const Json& raw(const std::string& key) const;
+  /// This node's raw JSON (read-only view; marks nothing as read).
   const Json& json() const { return *node_; }
+
+  /// Throws Error naming the file and key path of every key under this node
+  /// (nested objects and array elements opened through child()/array()
+  /// included) that no accessor ever queried, each with the nearest queried key
+  /// of its level as a hint ("did you mean ..."). Loaders call it when done.
+  void requireAllKeysRead() const;
+  /// This node with `patch` merged over it (RFC 7396 merge patch), as a new
+  /// reader named like this one. Its requireAllKeysRead() checks the patch's
+  /// keys first and names an unknown one by the patch's own key path (what the
+  /// user wrote). This node and the patch count as read in their own readers.
+  ParamReader mergedWith(const ParamReader& patch) const;
   /// "file.json: a.b" style location of this node, for messages.
   const std::string& where() const { return where_; }
   /// Location of a key under this node.
   std::string at(const std::string& key) const;
 
  private:
+  struct Tracker;
+  ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where,
+              std::shared_ptr<Tracker> tracker);
   const Json& require(const std::string& key) const;
+  void mark(const std::string& key) const;
   std::shared_ptr<const Json> root_;
+  std::shared_ptr<Tracker> tracker_;
   const Json* node_;
   std::string where_;
 };
