@@ -10,20 +10,26 @@ namespace vdyn {
 void EventLimits::validate() const {
   requirePositive(spin_out_side_slip_rad, "event limit spin_out_side_slip_rad");
   requirePositive(rollover_roll_rad, "event limit rollover_roll_rad");
+  requireNonNegative(spin_out_min_speed_m_s, "event limit spin_out_min_speed_m_s");
   requireFinite(lift_off_load_N, "event limit lift_off_load_N");
   requireFinite(start_time_s, "event limit start_time_s");
 }
 
 std::string Event::describe() const {
   char buf[256];
-  std::snprintf(buf, sizeof buf, "%s at t = %.6g s: %s = %.6g (limit %s%.6g)", kind.c_str(), time_s, object.c_str(),
-                value, kind == "lift_off" ? "<= " : "|.| > ", limit);
+  if (kind == "lift_off")
+    std::snprintf(buf, sizeof buf, "lift_off at t = %.6g s: %s = %.6g, at or below the stated %.6g", time_s,
+                  object.c_str(), value, limit);
+  else
+    std::snprintf(buf, sizeof buf, "%s at t = %.6g s: |%s| = %.6g beyond the stated limit %.6g", kind.c_str(), time_s,
+                  object.c_str(), std::abs(value), limit);
   return buf;
 }
 
 EventMonitor::EventMonitor(const Scene& scene, EventLimits limits) : scene_(scene), limits_(limits) {
   limits_.validate();
   slip_ = scene.hasOutput("chassis.side_slip_rad");
+  speed_ = scene.hasOutput("chassis.forward_speed_m_s");
   roll_ = scene.hasOutput("chassis.roll_rad");
   for (const auto& n : scene.getOutputNames())
     if (n.size() > 5 && n.compare(n.size() - 5, 5, ".Fz_N") == 0) loads_.push_back(n);
@@ -48,7 +54,10 @@ void EventMonitor::check(const SimTK::State& s) {
     events_.push_back({kind, object, t, value, limit});
     if (stop) throw RunStopped(events_.back(), stateSummary(scene_, s));
   };
-  if (slip_ && !seen("spin_out", "chassis.side_slip_rad")) {
+  // Side slip means nothing near standstill (atan2 of two tiny velocities).
+  const bool moving = !speed_ || std::abs(scene_.evalOutput("chassis.forward_speed_m_s", s)) >=
+                                     limits_.spin_out_min_speed_m_s;
+  if (slip_ && moving && !seen("spin_out", "chassis.side_slip_rad")) {
     const double b = scene_.evalOutput("chassis.side_slip_rad", s);
     if (!(std::abs(b) <= limits_.spin_out_side_slip_rad))
       fire("spin_out", "chassis.side_slip_rad", b, limits_.spin_out_side_slip_rad, limits_.stop_on_spin_out);

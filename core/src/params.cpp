@@ -66,7 +66,8 @@ class PathSax : public nlohmann::json_sax<Json> {
     return true;
   }
   bool parse_error(std::size_t pos, const std::string& token, const nlohmann::detail::exception& ex) override {
-    position = pos;
+    // pos is just past the offending token: point at its first character.
+    position = pos >= token.size() ? pos - token.size() + 1 : pos;
     std::string what = ex.what();
     // "[json.exception.parse_error.101] parse error at line 1, column 2: syntax error ..." -> the reason
     const auto colon = what.find(": ", what.find(']'));
@@ -150,6 +151,7 @@ struct ParamReader::Tracker {
   std::set<const Json*> opened;                          ///< nodes opened as readers (checked recursively)
   std::set<const Json*> consumed;                        ///< nodes taken over by raw() or mergedWith()
   std::shared_ptr<ParamReader> patch;                    ///< mergedWith(): the patch, checked first
+  std::string baseWhere;                                 ///< mergedWith(): where the base came from
 };
 
 ParamReader::ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where)
@@ -330,12 +332,16 @@ std::size_t editDistance(const std::string& a, const std::string& b) {
   return d[b.size()];
 }
 
+/// The candidate closest to `key`: edit distance, less twice the common prefix
+/// (so "gravity" finds "gravity_m_per_s2", a key without its unit).
 std::string nearest(const std::string& key, const std::set<std::string>& candidates) {
   std::string best;
-  std::size_t bestD = std::string::npos;
+  long bestD = 0;
   for (const auto& c : candidates) {
-    const std::size_t dist = editDistance(key, c);
-    if (dist < bestD) {
+    std::size_t prefix = 0;
+    while (prefix < key.size() && prefix < c.size() && key[prefix] == c[prefix]) ++prefix;
+    const long dist = long(editDistance(key, c)) - 2 * long(prefix);
+    if (best.empty() || dist < bestD) {
       bestD = dist;
       best = c;
     }
@@ -398,7 +404,7 @@ void ParamReader::requireAllKeysRead() const {
         };
     walkPatch(t.patch->json(), *node_, t.patch->where());
   }
-  if (problems.empty()) walk(*node_, where_);
+  if (problems.empty()) walk(*node_, t.patch && node_ == root_.get() && !t.baseWhere.empty() ? t.baseWhere : where_);
   if (problems.empty()) return;
   std::string msg;
   for (const auto& p : problems) msg += (msg.empty() ? "" : "; ") + p;
@@ -419,7 +425,11 @@ ParamReader ParamReader::mergedWith(const ParamReader& patch) const {
   auto root = std::make_shared<const Json>(std::move(m));
   auto tracker = std::make_shared<Tracker>();
   tracker->patch = std::make_shared<ParamReader>(patch);
-  return ParamReader(root, root.get(), where_, tracker);
+  // Named by the patch (what the user wrote); its requireAllKeysRead names an
+  // unknown key of the base by the base's own location.
+  ParamReader merged(root, root.get(), patch.where_, tracker);
+  tracker->baseWhere = where_;
+  return merged;
 }
 
 }  // namespace vdyn

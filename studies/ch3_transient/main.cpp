@@ -7,6 +7,7 @@
 
 #include "ch3_case.h"
 #include "study.h"
+#include "vdyn/core/events.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/fourws.h"
@@ -41,10 +42,44 @@ int main(int argc, char** argv) {
         "rear_steer.angle_rad", "front_steer.command_rad", "rear_steer.command_rad"};
     // (all at Stage::Velocity or lower: sampling never realizes accelerations)
     Recorder rec(car.getScene(), cols);
-    const RunSummary run = simulate(car.getScene(), s, sim, &rec, study::progress("ch3_transient", sim.t_end_s));
+    // Physical events (spin-out and rollover end the run) and, at the end, the
+    // steady verdict: the final values are the steady turn's only if the run
+    // ended steady; otherwise no radius is reported and the study exits 1.
+    EventMonitor events(car.getScene());
+    RunSummary run;
+    std::string stopped;
+    try {
+      run = simulate(car.getScene(), s, sim, &rec, events.callback(study::progress("ch3_transient", sim.t_end_s)));
+    } catch (const RunStopped& e) {
+      stopped = e.what();
+    }
     study::endProgress();
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
+    if (!stopped.empty()) {
+      study::writeJson(out + "/summary.json", {{"completed", false},
+                                               {"steady", false},
+                                               {"reason", stopped},
+                                               {"events", events.toJson()},
+                                               {"speed_m_s", U0},
+                                               {"front_rad", front},
+                                               {"rear_rad", rear},
+                                               {"event_limits",
+                                                {{"spin_out_side_slip_rad", events.limits().spin_out_side_slip_rad},
+                                                 {"rollover_roll_rad", events.limits().rollover_roll_rad}}}});
+      throw Error("the vehicle left its regime: " + stopped + " (no steady values; history up to the event in " + csv +
+                  ")");
+    }
+    const double steadyWindow = 2.0, steadyRel = 1e-3, steadyAbs = 1e-5;
+    study::SteadyVerdict verdict =
+        study::checkSteady(rec.time(), rec.column("chassis.yaw_rate_rad_s"), "yaw rate (rad/s)", ch3.settledTime(),
+                           steadyWindow, steadyRel, steadyAbs);
+    if (verdict.steady) {
+      const study::SteadyVerdict slip = study::checkSteady(rec.time(), rec.column("chassis.side_slip_rad"),
+                                                           "side slip (rad)", ch3.settledTime(), steadyWindow,
+                                                           steadyRel, steadyAbs);
+      if (!slip.steady) verdict = slip;
+    }
 
     double steerError = 0;  // largest |angle - command| over the samples, both axles
     for (const char* axle : {"front_steer", "rear_steer"}) {
@@ -55,14 +90,21 @@ int main(int argc, char** argv) {
     const Scene& sc = car.getScene();
     auto fin = [&](const std::string& n) { return sc.evalOutput(n, s); };
     const double r = fin("chassis.yaw_rate_rad_s");
-    Json summary = {{"yaw_rate_rad_s", r},
+    Json summary = {{"completed", true},
+                    {"steady", verdict.steady},
+                    {"steady_check", {{"window_s", steadyWindow},
+                                      {"relative_tolerance", steadyRel},
+                                      {"absolute_tolerance", steadyAbs},
+                                      {"verdict", verdict.toJson()}}},
+                    {"events", events.toJson()},
+                    {"yaw_rate_rad_s", r},
                     {"roll_rate_rad_s", fin("chassis.roll_rate_rad_s")},
                     {"pitch_rate_rad_s", fin("chassis.pitch_rate_rad_s")},
                     {"roll_rad", fin("chassis.roll_rad")},
                     {"pitch_rad", fin("chassis.pitch_rad")},
                     {"chassis_z_m", fin("chassis.z_m")},
                     {"wheel_spin_rad_s", {fin("rf.spin_rad_s"), fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s")}},
-                    {"path_radius_m", U0 / r},
+                    {"path_radius_m", verdict.steady ? Json(U0 / r) : Json(nullptr)},
                     {"side_slip_rad", fin("chassis.side_slip_rad")},
                     {"speed_hold_force_N", fin("speed_hold.force_N")},
                     {"dof", dof},
@@ -92,7 +134,11 @@ int main(int argc, char** argv) {
     }
     std::printf("ch3_transient: U0 = %g m/s, front %.3f deg, rear %.3f deg, %s at %g, T = %g s\n", U0, front / deg,
                 rear / deg, run.integrator.c_str(), run.accuracy, sim.t_end_s);
-    std::printf("  yaw rate            %.6f rad/s (path radius %.3f m)\n", r, U0 / r);
+    if (verdict.steady)
+      std::printf("  yaw rate            %.6f rad/s (path radius %.3f m), steady\n", r, U0 / r);
+    else
+      std::printf("  yaw rate at the end %.6f rad/s: NOT steady (%s)\n", r, verdict.reason.c_str());
+    for (const auto& e : events.events()) std::printf("  event: %s\n", e.describe().c_str());
     std::printf("  roll / pitch        %.6f / %.6f rad (rates %.2e / %.2e rad/s)\n", fin("chassis.roll_rad"),
                 fin("chassis.pitch_rad"), fin("chassis.roll_rate_rad_s"), fin("chassis.pitch_rate_rad_s"));
     std::printf("  chassis height      %.6f m; side slip %.6f rad; speed-hold force %.2f N\n", fin("chassis.z_m"),
@@ -103,5 +149,7 @@ int main(int argc, char** argv) {
                 car.totalMass(), run.max_constraint_error, steerError, run.steps);
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
+    if (!verdict.steady)
+      throw Error("no steady turn: " + verdict.reason + " (summary.json: steady false; no path radius reported)");
   });
 }

@@ -1,6 +1,8 @@
 #include "study.h"
 
+#include <cerrno>
 #include <chrono>
+#include <cstring>
 #include <cmath>
 #include <cstdio>
 #include <memory>
@@ -14,6 +16,11 @@
 
 namespace vdyn::study {
 
+namespace {
+std::string g_outputDir;        // outputDir() of this run, once created
+bool g_summaryWritten = false;  // writeJson() wrote <out>/summary.json
+}  // namespace
+
 int run(const std::string& study, const std::function<void()>& body) {
   try {
     body();
@@ -22,6 +29,15 @@ int run(const std::string& study, const std::function<void()>& body) {
     std::string msg = e.what();
     for (auto& c : msg)
       if (c == '\n') c = ' ';
+    // The run failed before its summary: say so in summary.json, so that folder
+    // never holds a summary that looks like a result (best effort: the error
+    // itself may be that nothing can be written there).
+    if (!g_outputDir.empty() && !g_summaryWritten) {
+      try {
+        writeJson(g_outputDir + "/summary.json", {{"completed", false}, {"error", msg}});
+      } catch (const std::exception&) {
+      }
+    }
     std::cerr << study << ": error: " << msg << std::endl;
     return 1;
   }
@@ -58,17 +74,31 @@ std::string outputDir(const po::variables_map& vm, const std::string& study) {
   std::error_code ec;
   std::filesystem::create_directories(dir, ec);
   if (ec) throw Error("cannot create output folder '" + dir + "': " + ec.message());
+  // A summary of an earlier run must not pass for this one's.
+  std::filesystem::remove(dir + "/summary.json", ec);
+  if (ec) throw Error("cannot write to output folder '" + dir + "': " + ec.message());
+  if (::access(dir.c_str(), W_OK) != 0)
+    throw Error("cannot write to output folder '" + dir + "': " + std::strerror(errno));
+  g_outputDir = dir;
   return dir;
 }
 
 void writeJson(const std::string& path, const Json& j) {
+  const bool summary = path.size() >= 12 && path.compare(path.size() - 12, 12, "summary.json") == 0;
   std::string text;
   try {
-    text = j.dump(2) + "\n";
+    if (summary && j.is_object() && !j.contains("completed")) {
+      Json withFlag = {{"completed", true}};
+      withFlag.update(j);
+      text = withFlag.dump(2) + "\n";
+    } else {
+      text = j.dump(2) + "\n";
+    }
   } catch (const nlohmann::json::exception& e) {
     throw Error("cannot write '" + path + "': " + e.what());
   }
   writeFileAtomic(path, text);
+  if (summary) g_summaryWritten = true;
 }
 
 void writeFileAtomic(const std::string& path, const std::string& text) { vdyn::writeFileAtomic(path, text); }
@@ -106,6 +136,39 @@ double checkSteerAngle(const Given& g, bool optionInDeg) {
       throw Error(g.name + " must lie in [-0.785398, 0.785398] rad (+-45 deg), got " + formatValue(g.value));
   }
   return g.value;
+}
+
+Json SteadyVerdict::toJson() const {
+  Json j = {{"steady", steady}, {"spread", spread}, {"tolerance", tolerance}};
+  if (!steady) j["reason"] = reason;
+  return j;
+}
+
+SteadyVerdict checkSteady(const std::vector<double>& t, const std::vector<double>& y, const std::string& name,
+                          double settled_s, double window_s, double rel_tol, double abs_tol) {
+  SteadyVerdict v;
+  if (t.empty() || t.size() != y.size()) {
+    v.reason = "no samples of " + name;
+    return v;
+  }
+  const double tEnd = t.back(), yEnd = y.back();
+  v.tolerance = rel_tol * std::abs(yEnd) + abs_tol;
+  if (tEnd - window_s < settled_s) {
+    v.reason = "the run ends at t = " + formatValue(tEnd) + " s, before a " + formatValue(window_s) +
+               " s window after the commands settle at " + formatValue(settled_s) + " s";
+    return v;
+  }
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i] >= tEnd - window_s) v.spread = std::max(v.spread, std::isfinite(y[i]) ? std::abs(y[i] - yEnd) : INFINITY);
+  if (!(v.spread <= v.tolerance)) {
+    char buf[256];
+    std::snprintf(buf, sizeof buf, "%s varies by %.3g over the last %g s (tolerance %.3g = %g |final| + %g)",
+                  name.c_str(), v.spread, window_s, v.tolerance, rel_tol, abs_tol);
+    v.reason = buf;
+    return v;
+  }
+  v.steady = true;
+  return v;
 }
 
 void checkRunTimes(const Given& tEnd, const Given& dt) {

@@ -18,6 +18,8 @@ namespace vdyn::study {
 namespace po = boost::program_options;
 
 /// Runs `body`; returns 0, or prints "<study>: error: <message>" and returns 1.
+/// If the output folder exists and no summary.json was written, it writes
+/// {"completed": false, "error": message} there.
 int run(const std::string& study, const std::function<void()>& body);
 
 /// Parses the command line. Adds --help and --out; on --help prints the options
@@ -48,17 +50,32 @@ double checkSteerAngle(const Given& g, bool optionInDeg);
 /// most the run, and at most 1e6 samples), named as given.
 void checkRunTimes(const Given& tEnd, const Given& reportInterval);
 
+/// Whether a recorded history ended steady: over the last `window_s` of the run
+/// (which must start after `settled_s`, when every command has settled) every
+/// sample lies within rel_tol |y_end| + abs_tol of the final value.
+struct SteadyVerdict {
+  bool steady = false;
+  std::string reason;  ///< why not (empty when steady)
+  double spread = 0;   ///< largest |y - y_end| over the window
+  double tolerance = 0;
+  Json toJson() const;
+};
+SteadyVerdict checkSteady(const std::vector<double>& t, const std::vector<double>& y, const std::string& name,
+                          double settled_s, double window_s, double rel_tol, double abs_tol);
+
 /// Adds --integrator NAME and --accuracy X (every study that integrates takes them).
 void addIntegratorOptions(po::options_description& options);
 /// Applies --integrator and --accuracy, where given, over `settings` (read from a data file).
 void applyIntegratorOptions(const po::variables_map& vm, IntegratorSettings& settings);
 
-/// The output folder (created): --out, or <repo>/results/<study>.
+/// The output folder (created, checked writable; an old summary.json in it is
+/// removed): --out, or <repo>/results/<study>.
 std::string outputDir(const po::variables_map& vm, const std::string& study);
 
 /// Writes JSON (pretty) to a file, atomically: the text goes to "<path>.tmp",
 /// every write is checked (a full disk is a named Error), and the file is
 /// renamed to `path` only when complete, so `path` is never half-written.
+/// A summary.json object without "completed" gets "completed": true.
 void writeJson(const std::string& path, const Json& j);
 /// Writes `text` to `path` the same way (temporary name, checked, renamed).
 void writeFileAtomic(const std::string& path, const std::string& text);

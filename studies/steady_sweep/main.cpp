@@ -18,9 +18,13 @@
 using namespace vdyn;
 
 namespace {
-std::vector<double> range(double a, double b, double step, const std::string& what) {
-  requirePositive(step, what + " step");
+std::vector<double> range(double a, double b, double step, const std::string& what, const std::string& stepName) {
+  requirePositive(step, stepName);
   if (!(b >= a)) throw Error(what + ": the end (" + formatValue(b) + ") is below the start (" + formatValue(a) + ")");
+  if ((b - a) / step > 1000)
+    throw Error(stepName + " = " + formatValue(step) + " gives " + formatValue(std::floor((b - a) / step) + 1) +
+                " points from " + formatValue(a) + " to " + formatValue(b) + " (at most 1001; " + stepName +
+                " must be at least " + formatValue((b - a) / 1000) + ")");
   std::vector<double> v;
   for (int i = 0; a + i * step <= b + 1e-9 * step; ++i) v.push_back(a + i * step);
   return v;
@@ -43,11 +47,16 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("steady_sweep", "steady turning over speed x front steering angle by continuation", argc,
                                  argv, opts);
     const double deg = SimTK::Pi / 180;
-    const auto speeds = range(vm["speed-min-m-s"].as<double>(), vm["speed-max-m-s"].as<double>(),
-                              vm["speed-step-m-s"].as<double>(), "--speed-min-m-s .. --speed-max-m-s");
-    const auto fronts = range(vm["front-min-deg"].as<double>(), vm["front-max-deg"].as<double>(),
-                              vm["front-step-deg"].as<double>(), "--front-min-deg .. --front-max-deg");
-    for (double U : speeds) requirePositive(U, "--speed-min-m-s");
+    // Ranges first, with the option names: a speed step of 1e-300 or a top
+    // speed of 1e12 is refused here, not after the memory runs out.
+    const double speedMin = study::checkSpeed(study::optionOr(vm, "speed-min-m-s", 0.0, ""));
+    const double speedMax = study::checkSpeed(study::optionOr(vm, "speed-max-m-s", 0.0, ""));
+    const double speedStep = requireFinite(vm["speed-step-m-s"].as<double>(), "--speed-step-m-s");
+    const double frontMin = study::checkSteerAngle(study::optionOr(vm, "front-min-deg", 0.0, "", deg), true) / deg;
+    const double frontMax = study::checkSteerAngle(study::optionOr(vm, "front-max-deg", 0.0, "", deg), true) / deg;
+    const double frontStep = requireFinite(vm["front-step-deg"].as<double>(), "--front-step-deg");
+    const auto speeds = range(speedMin, speedMax, speedStep, "--speed-min-m-s .. --speed-max-m-s", "--speed-step-m-s");
+    const auto fronts = range(frontMin, frontMax, frontStep, "--front-min-deg .. --front-max-deg", "--front-step-deg");
     const double ratio = requireFinite(vm["rear-ratio"].as<double>(), "--rear-ratio");
     const std::string out = study::outputDir(vm, "steady_sweep");
 

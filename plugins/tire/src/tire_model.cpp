@@ -16,6 +16,8 @@ double travelDirection(const ContactKinematics& k, double veps) {
 
 void TireParams::validate(const std::string& w) const {
   requirePositive(unloaded_radius_m, w + ".unloaded_radius_m");
+  if (unloaded_radius_m > 1.5)  // a road vehicle's tire; 3 m stalls the vehicle's assembly and run
+    throw Error(w + ".unloaded_radius_m must lie in (0, 1.5] m, got " + formatValue(unloaded_radius_m));
   requireNonNegative(carcass_radius_m, w + ".carcass_radius_m");
   if (!(carcass_radius_m < unloaded_radius_m))
     throw Error(w + ".carcass_radius_m must be smaller than unloaded_radius_m, got " +

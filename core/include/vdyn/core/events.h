@@ -19,6 +19,8 @@ namespace vdyn {
 struct EventLimits {
   /// Spin-out when |chassis.side_slip_rad| exceeds this, rad (0.35 rad = 20 deg).
   double spin_out_side_slip_rad = 0.35;
+  /// ... checked only while |chassis.forward_speed_m_s| is at least this, m/s.
+  double spin_out_min_speed_m_s = 1.0;
   /// Rollover when |chassis.roll_rad| exceeds this, rad (0.8 rad = 46 deg).
   double rollover_roll_rad = 0.8;
   /// Lift-off when a tire's normal load (outputs "<tire>.Fz_N") is at most this, N.
@@ -36,7 +38,8 @@ struct Event {
   double time_s = 0;   ///< end of the step where it was first seen
   double value = 0;    ///< the output's value then
   double limit = 0;    ///< the stated limit
-  std::string describe() const;  ///< "spin_out at t = 3.21 s: chassis.side_slip_rad = -0.36 (limit 0.35)"
+  /// "spin_out at t = 3.52 s: |chassis.side_slip_rad| = 0.3526 beyond the stated limit 0.35"
+  std::string describe() const;
 };
 
 /// Thrown from the step callback when a stopping event happens.
@@ -65,7 +68,7 @@ class EventMonitor {
   const Scene& scene_;
   EventLimits limits_;
   std::vector<std::string> loads_;
-  bool slip_ = false, roll_ = false;
+  bool slip_ = false, roll_ = false, speed_ = false;
   std::vector<Event> events_;
   bool seen(const std::string& kind, const std::string& object) const;
 };
