@@ -42,7 +42,10 @@ struct Ch3Case {
     const po::variables_map& v = vm ? *vm : none;
     Ch3Case c;
     c.vehicle_data = data.string("vehicle_data");
-    c.speed_m_s = checkSpeed(optionOr(v, "speed-m-s", data, "speed_m_s"));
+    // Below 0.5 m/s (the tires' low-speed threshold) the vehicle does not roll
+    // but creeps on the slip regularization: 1e-6 m/s crawled at 2e-6 s steps.
+    c.speed_m_s = checkSpeedAtLeast(optionOr(v, "speed-m-s", data, "speed_m_s"), 0.5,
+                                    "a steady turn needs the tires rolling");
     c.front_rad = checkSteerAngle(optionOr(v, "front-deg", data, "front_angle_rad", deg), true);
     c.rear_rad = checkSteerAngle(optionOr(v, "rear-deg", data, "rear_angle_rad", deg), true);
     c.steer_start_s = requireNonNegative(data.number("steer_start_time_s"), data.at("steer_start_time_s"));

@@ -125,6 +125,13 @@ double checkSpeed(const Given& g, bool allowZero) {
   return g.value;
 }
 
+double checkSpeedAtLeast(const Given& g, double lo, const std::string& why) {
+  requireFinite(g.value, g.name);
+  if (!(g.value >= lo) || g.value > 100)
+    throw Error(g.name + " must lie in [" + formatValue(lo) + ", 100] m/s (" + why + "), got " + formatValue(g.value));
+  return g.value;
+}
+
 double checkSteerAngle(const Given& g, bool optionInDeg) {
   const double deg = SimTK::Pi / 180;
   const bool option = g.name.rfind("--", 0) == 0;

@@ -45,6 +45,8 @@ Given optionOr(const po::variables_map& vm, const std::string& option, double fa
 /// Physical ranges (bounds in the message): a forward speed in (0, 100] m/s
 /// (`allowZero`: [0, 100]); a road-wheel steering angle in [-45, 45] deg.
 double checkSpeed(const Given& g, bool allowZero = false);
+/// A rolling speed in [min_m_s, 100] m/s: `why` says what needs it.
+double checkSpeedAtLeast(const Given& g, double min_m_s, const std::string& why);
 double checkSteerAngle(const Given& g, bool optionInDeg);
 /// A run's end time (finite, > 0, at most 1e5 s) and report interval (> 0, at
 /// most the run, and at most 1e6 samples), named as given.

@@ -142,7 +142,7 @@ add('File.BadComment', 1, 'is not valid JSON', '{"based_on": "quarter_car.json" 
 
 # --- ch3_transient data file ---------------------------------------------------------------------------
 for key, typo, neg, text_neg in [
-        ('speed_m_s', 'speed_ms', -5, 'speed_m_s must lie in (0, 100] m/s, got -5'),
+        ('speed_m_s', 'speed_ms', -5, 'speed_m_s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got -5'),
         ('front_angle_rad', 'front_angel_rad', -1.0, 'front_angle_rad must lie in [-0.785398, 0.785398] rad'),
         ('rear_angle_rad', 'rear_angel_rad', 2.0, 'rear_angle_rad must lie in [-0.785398, 0.785398] rad'),
         ('steer_start_time_s', 'steer_start_s', -1, 'steer_start_time_s must not be negative, got -1'),
@@ -153,9 +153,9 @@ for key, typo, neg, text_neg in [
     add(f'Ch3.{key}.Missing', 1, f'{key}: missing key', variant('ch3_transient.json', {key: None}), CH3)
     add(f'Ch3.{key}.Inf', 1, f'key {key}): number out of range', variant('ch3_transient.json', {key: 0}).replace(f'"{key}": 0', f'"{key}": -1e999'), CH3)
     add(f'Ch3.{key}.OutOfRange', 1, text_neg, variant('ch3_transient.json', {key: neg}), CH3)
-add('Ch3.speed_m_s.Huge', 1, 'ch3_transient case.json: speed_m_s must lie in (0, 100] m/s, got 1000' if False else 'speed_m_s must lie in (0, 100] m/s, got 1000',
+add('Ch3.speed_m_s.Huge', 1, 'ch3_transient case.json: speed_m_s must lie in (0, 100] m/s, got 1000' if False else 'speed_m_s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got 1000',
     variant('ch3_transient.json', {"speed_m_s": 1000}), CH3)
-add('Ch3.speed_m_s.Zero', 1, 'speed_m_s must lie in (0, 100] m/s, got 0', variant('ch3_transient.json', {"speed_m_s": 0}), CH3)
+add('Ch3.speed_m_s.Zero', 1, 'speed_m_s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got 0', variant('ch3_transient.json', {"speed_m_s": 0}), CH3)
 add('Ch3.Simulation.Unknown', 1, "simulation.t_end: unknown key (did you mean 't_end_s'?)",
     variant('ch3_transient.json', {"simulation": {"t_end": 3}}), CH3)
 add('Ch3.Integrator.Unknown', 1, "simulation.integrator.methd: unknown key (did you mean 'method'?)",
@@ -194,9 +194,10 @@ for name, patch, text in [
 opt_cases = [
     ('SpeedNaN', '--speed-m-s nan', '--speed-m-s must be a finite number, got nan'),
     ('SpeedInf', '--speed-m-s inf', '--speed-m-s must be a finite number, got inf'),
-    ('SpeedNegative', '--speed-m-s -10', '--speed-m-s must lie in (0, 100] m/s, got -10'),
-    ('SpeedZero', '--speed-m-s 0', '--speed-m-s must lie in (0, 100] m/s, got 0'),
-    ('SpeedHuge', '--speed-m-s 1000', '--speed-m-s must lie in (0, 100] m/s, got 1000'),
+    ('SpeedNegative', '--speed-m-s -10', '--speed-m-s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got -10'),
+    ('SpeedZero', '--speed-m-s 0', '--speed-m-s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got 0'),
+    ('SpeedCreep', '--speed-m-s 1e-6', '--speed-m-s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got 1e-06'),
+    ('SpeedHuge', '--speed-m-s 1000', '--speed-m-s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got 1000'),
     ('SpeedText', '--speed-m-s fast', "the argument ('fast') for option '--speed-m-s' is invalid"),
     ('SpeedEmpty', '--speed-m-s', "the required argument for option '--speed-m-s' is missing"),
     ('FrontNaN', '--front-deg nan', '--front-deg must be a finite number, got nan'),
@@ -244,7 +245,7 @@ for name, args, text in [
 
 # other studies: options and positional arguments
 for study, args, text in [
-        ('ch3_steady_state', '--speed-m-s -1', '--speed-m-s must lie in (0, 100] m/s, got -1'),
+        ('ch3_steady_state', '--speed-m-s -1', '--speed-m-s must lie in [0.5, 100] m/s (a steady turn needs the tires rolling), got -1'),
         ('ch3_steady_state', '--front-deg nan', '--front-deg must be a finite number, got nan'),
         ('ch3_steady_state', 'stray', "unexpected argument 'stray'"),
         ('ch7_open_loop', '--speed-m-s 0', '--speed-m-s must lie in (0, 100] m/s, got 0'),
