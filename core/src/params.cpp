@@ -128,6 +128,9 @@ Json parseJsonText(const std::string& text, const std::string& name) {
 }
 
 Json readJsonFile(const std::string& path) {
+  struct stat st;
+  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw Error("data file '" + path + "' is a folder, not a JSON file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open data file '" + path + "'");
   std::ostringstream text;

@@ -58,6 +58,15 @@ struct Ch3Case {
     c.sim.report_interval_s = dt.value;
     c.sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
     if (vm) applyIntegratorOptions(*vm, c.sim.integrator);
+    // semi_explicit_euler2's error estimate does not bound the error of this
+    // scene: at accuracy 1e-3 (0.5 m/s, 2 deg) it ended at a yaw rate of
+    // -0.129 rad/s against 0.0078 from every other integrator (issue 12; the
+    // stress matrix, build/bin/stress, measures it against a 1e-9 reference).
+    if (c.sim.integrator.method == "semi_explicit_euler2" && c.sim.integrator.accuracy > 1e-6)
+      throw Error("integrator semi_explicit_euler2 at accuracy " + formatValue(c.sim.integrator.accuracy) +
+                  " is refused for the chapter 3 vehicle: its error estimate leaves out the velocity-dependent tire "
+                  "and damper forces and does not bound the error here (a wrong yaw rate at 1e-3); use accuracy "
+                  "<= 1e-6 or another integrator");
     data.requireAllKeysRead();
     return c;
   }

@@ -49,7 +49,12 @@ po::variables_map parse(const std::string& study, const std::string& summary, in
       "out", po::value<std::string>(), "output folder (default: results/<study>/ in the repository)");
   po::variables_map vm;
   try {
-    const po::parsed_options parsed = po::command_line_parser(argc, argv).options(options).run();
+    // No guessing of abbreviated options: "--speed 3" is not "--speed-m-s 3".
+    const po::parsed_options parsed =
+        po::command_line_parser(argc, argv)
+            .options(options)
+            .style(po::command_line_style::default_style & ~po::command_line_style::allow_guessing)
+            .run();
     // A stray word (a value without its option, a misspelled "-out") is an
     // error, never silently ignored.
     for (const auto& o : parsed.options)

@@ -86,7 +86,8 @@ for key, text in [('chassis_mass_kg', 'chassis_mass_kg: missing key'), ('simulat
                   ('road', 'road: missing key'), ('road.type', 'road.type: missing key'),
                   ('vehicle_data', 'vehicle_data: missing key'),
                   ('simulation.integrator', 'simulation.integrator: missing key')]:
-    add(f'QC.Missing.{key.replace(".", "_")}', 1, text, variant('quarter_car.json', nested(key, None)), QC)
+    add(f'QC.Missing.{key.replace(".", "_")}', 1, text, variant('quarter_car.json', nested(key, None)),
+        'quarter_car --no-plots --out {OUT} --data {CASE}')
 # other quarter-car keys
 add('QC.RoadType.Unknown', 1, "road.type: unknown road type 'bumpy'; known: flat, sine",
     variant('quarter_car.json', {"road": {"type": "bumpy"}}), QC)
@@ -118,7 +119,7 @@ add('QC.DuplicateKey', 1, "duplicate key 'chassis_mass_kg'",
     '{"based_on": "quarter_car.json", "chassis_mass_kg": 100, "chassis_mass_kg": 200}', QC)
 add('QC.TEnd.Negative', 1, 'simulation.t_end_s must lie in (0, 1e5] s, got -1',
     variant('quarter_car.json', {"simulation": {"t_end_s": -1}}), 'quarter_car --no-plots --out {OUT} --data {CASE}')
-add('QC.TEnd.Huge', 1, 'simulation.t_end_s must lie in (0, 1e5] s, got 1e+06',
+add('QC.TEnd.Huge', 1, 'simulation.t_end_s must lie in (0, 1e5] s, got 1000000',
     variant('quarter_car.json', {"simulation": {"t_end_s": 1e6}}), 'quarter_car --no-plots --out {OUT} --data {CASE}')
 add('QC.ReportInterval.AboveRun', 1, 'must not exceed the run',
     variant('quarter_car.json', {"simulation": {"report_interval_s": 5}}), 'quarter_car --no-plots --out {OUT} --data {CASE}')
@@ -137,7 +138,7 @@ add('File.Garbage', 1, 'is not valid JSON', 'vdyn', QC)
 add('File.BasedOnMissing', 1, "data file 'nowhere.json' not found", '{"based_on": "nowhere.json"}', QC)
 add('File.BasedOnWrongType', 1, 'based_on: expected a data file name, got 3', '{"based_on": 3}', QC)
 add('File.BasedOnSelf', 1, 'based_on: the variants form a cycle', '{"based_on": "case.json"}', 'quarter_car --no-plots --out {OUT} --data {CASE}')
-add('File.Directory', 1, "cannot", None, 'quarter_car --no-plots --out {OUT} --data {DATA}')
+add('File.Directory', 1, "is a folder, not a JSON file", None, 'quarter_car --no-plots --out {OUT} --data {DATA}')
 add('File.BadComment', 1, 'is not valid JSON', '{"based_on": "quarter_car.json" /* unterminated', QC)
 
 # --- ch3_transient data file ---------------------------------------------------------------------------
@@ -278,7 +279,7 @@ for study, args, text in [
     add(f'{study}.{tag}.{len(cases)}', 1, text, None, f'{study} --no-plots --out {{OUT}} {args}' if study != 'ch3_steady_state' else f'{study} --out {{OUT}} {args}')
 
 # --- output folder and full disk ------------------------------------------------------------------------
-add('Output.Unwritable', 1, 'cannot write to output folder', None, 'quarter_car --no-plots --t-end-s 0.01 --out {RO}')
+add('Output.Unwritable', 1, "cannot write", None, 'quarter_car --no-plots --t-end-s 0.01 --out {RO}')
 add('Output.IsAFile', 1, 'cannot create output folder', None, 'quarter_car --no-plots --t-end-s 0.01 --out {FILE}')
 add('Output.FullDiskSummary', 1, "cannot write '{OUT}/summary.json': write failed: No space left on device", None,
     'quarter_car --no-plots --t-end-s 0.01 --out {OUT} {FULL:summary.json}')

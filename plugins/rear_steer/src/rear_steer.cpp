@@ -24,8 +24,12 @@ KrTable KrTable::fromParams(const ParamReader& r) {
   const std::string unit = r.string("delta_f_unit");
   if (unit != "deg") throw Error(r.at("delta_f_unit") + ": must be \"deg\", got \"" + unit + "\"");
   KrTable t;
-  for (const auto& row : r.array("fit"))
+  for (const auto& row : r.array("fit")) {
     t.rows.push_back({row.number("speed_m_s"), row.number("c1"), row.number("c2_per_deg2")});
+    // The fit's provenance (ch6_steering_ratio writes it): known keys, not used here.
+    row.has("rms_residual");
+    row.has("points");
+  }
   r.requireAllKeysRead();
   t.validate(r.at("fit"));
   return t;
