@@ -348,7 +348,7 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
     throw SteadyStateError(
         std::string("steady state did not converge") + (stalled ? " (no descent along the Newton direction)" : "") +
         ": " + std::to_string(res.iterations) + " iterations; failing: " + failing + "; " + blocksText +
-        "; worst scaled equation: " + describeEquation(int(worst)) + " = " + formatValue(r[worst]) +
+        "; worst equation (scaled): " + describeEquation(int(worst)) + " = " + formatValue(r[worst]) +
         " (no steady state may exist here: beyond the limit of adhesion or past a fold of the branch)");
   }
   res.multipliers.resize(m_);
