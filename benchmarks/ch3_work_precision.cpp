@@ -1,12 +1,26 @@
 // Run time against error for the chapter 3 transient of the 4WS vehicle
-// (ch3_transient's manoeuvre): each integrator at accuracies 1e-3 .. 1e-8
-// against a reference at 1e-10, with the real-time factor (simulated / wall s).
+// (ch3_transient's manoeuvre), for both corner models (constrained: the loops
+// and steering closed by constraint rows; reduced: the loops solved in the
+// knuckle's mobilizer), each integrator at accuracies 1e-3 .. 1e-8 against a
+// reference at 1e-10 of the same model.
 //
-// Error: max over t of |r(t) - r_ref(t)| / max |r_ref| for the yaw rate r,
-// sampled every 50 ms (the roll angle's error is reported the same way).
-#include <chrono>
+// Per run: steps, forward-dynamics evaluations (integrator realizations), CPU
+// time (std::clock: this process's CPU, not wall time), real-time factor
+// (simulated s / CPU s), errors. Error: max over t of |r(t) - r_ref(t)| /
+// max |r_ref| for the yaw rate r, sampled every --report-interval-s (50 ms by
+// default, as before; the roll angle's error the same way).
+//
+// Cost per evaluation: CPU time of one forward-dynamics evaluation
+// (realize to Acceleration) of each model in its initial state, as a ratio to
+// the same tree with every constraint disabled, measured in the same run.
+//
+// Headline: the data file's integrator and accuracy, --repeats runs of each
+// model alternately; medians of CPU time and RTF and the same-run ratio.
+// Both models start from the same state (the reduced one from the
+// constrained one's assembled initial state, FourWsVehicle::makeStateLike).
 #include <cmath>
 #include <cstdio>
+#include <ctime>
 #include <fstream>
 
 #include "bench_util.h"
@@ -19,25 +33,50 @@
 using namespace vdyn;
 
 namespace {
+double cpuNow() { return double(std::clock()) / CLOCKS_PER_SEC; }
+
 struct Run {
   std::vector<double> yaw, roll;
   RunSummary sum;
+  double cpu_s = 0;
 };
 
-Run runCh3(const ParamReader& data, const std::string& method, double accuracy, double tEnd) {
-  const study::Ch3Case ch3 = study::Ch3Case::fromData(data);
-  const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
-  const FourWsVehicle& car = *carPtr;
-  const double U0 = ch3.speed_m_s;
-  SimTK::State s = car.makeInitialState(U0);
-  SimulationSettings sim = ch3.sim;  // the data file's constraint tolerance; method, accuracy and time swept
+/// The vehicle of `model` and its initial state (the constrained model's, mapped for the reduced one).
+struct Setup {
+  std::unique_ptr<FourWsVehicle> car;
+  SimTK::State initial;
+};
+
+Setup makeSetup(const study::Ch3Case& ch3, const std::string& model) {
+  Setup st;
+  auto con = ch3.buildVehicle("constrained");
+  SimTK::State s0 = con->makeInitialState(ch3.speed_m_s);
+  if (model == "constrained") {
+    st.car = std::move(con);
+    st.initial = s0;
+  } else {
+    st.car = ch3.buildVehicle(model);
+    st.initial = st.car->makeStateLike(*con, s0);
+  }
+  return st;
+}
+
+double gReportInterval = 0.05;
+
+Run runCh3(const study::Ch3Case& ch3, const std::string& model, const std::string& method, double accuracy,
+           double tEnd) {
+  Setup st = makeSetup(ch3, model);
+  SimTK::State s = st.initial;
+  SimulationSettings sim = ch3.sim;  // the data file's constraint tolerance
   sim.t_end_s = tEnd;
-  sim.report_interval_s = 0.05;
+  sim.report_interval_s = gReportInterval;
   sim.integrator.method = method;
   sim.integrator.accuracy = accuracy;
-  Recorder rec(car.getScene(), {"chassis.yaw_rate_rad_s", "chassis.roll_rad"});
+  Recorder rec(st.car->getScene(), {"chassis.yaw_rate_rad_s", "chassis.roll_rad"});
   Run r;
-  r.sum = simulate(car.getScene(), s, sim, &rec);
+  const double c0 = cpuNow();
+  r.sum = simulate(st.car->getScene(), s, sim, &rec);
+  r.cpu_s = cpuNow() - c0;
   r.yaw = rec.column("chassis.yaw_rate_rad_s");
   r.roll = rec.column("chassis.roll_rad");
   return r;
@@ -45,11 +84,34 @@ Run runCh3(const ParamReader& data, const std::string& method, double accuracy, 
 
 double relErr(const std::vector<double>& a, const std::vector<double>& ref) {
   double e = 0, scale = 0;
-  for (std::size_t i = 0; i < ref.size(); ++i) {
+  for (std::size_t i = 0; i < ref.size() && i < a.size(); ++i) {
     e = std::max(e, std::abs(a[i] - ref[i]));
     scale = std::max(scale, std::abs(ref[i]));
   }
   return e / scale;
+}
+
+/// CPU s per forward-dynamics evaluation of the model at its initial state,
+/// with its constraints (first) and with every constraint disabled (second).
+std::pair<double, double> evaluationCost(const study::Ch3Case& ch3, const std::string& model, int n) {
+  Setup st = makeSetup(ch3, model);
+  const SimTK::MultibodySystem& sys = st.car->getScene().getSystem();
+  auto time = [&](SimTK::State s) {
+    sys.realize(s, SimTK::Stage::Acceleration);
+    const double c0 = cpuNow();
+    for (int i = 0; i < n; ++i) {
+      s.updU()[0] += 1e-300 * i;  // invalidates Velocity and later: one full evaluation
+      s.updQ()[0] += 0.0;         // and Position
+      sys.realize(s, SimTK::Stage::Acceleration);
+    }
+    return (cpuNow() - c0) / n;
+  };
+  const double withRows = time(st.initial);
+  SimTK::State free = st.initial;
+  const SimTK::SimbodyMatterSubsystem& m = st.car->getScene().getMatter();
+  for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(free);
+  const double tree = time(free);
+  return {withRows, tree};
 }
 }  // namespace
 
@@ -58,48 +120,118 @@ int main(int argc, char** argv) {
     namespace po = study::po;
     po::options_description opts("Options");
     opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file")(
+        "models", po::value<std::string>()->default_value("constrained,reduced"), "comma-separated corner models")(
         "integrators", po::value<std::string>()->default_value("rk_merson,rk3,rk_feldberg,cpodes"),
         "comma-separated integrator names")(
         "accuracies", po::value<std::string>()->default_value("1e-3,1e-4,1e-5,1e-6,1e-7,1e-8"), "comma-separated accuracies")(
         "reference-accuracy", po::value<double>()->default_value(1e-10), "accuracy of the rk_merson reference")(
+        "repeats", po::value<int>()->default_value(5), "runs of each model at the data file's setting (medians)")(
+        "cost-evaluations", po::value<int>()->default_value(300), "evaluations timed for the cost per evaluation")(
+        "skip-sweep", "only the references, the cost per evaluation and the headline runs")(
+        "report-interval-s", po::value<double>()->default_value(0.05), "sampling interval of the histories, s")(
         "t-end-s", po::value<double>()->default_value(20.0), "simulated time, s")("no-plots", "skip the PNG plot");
     const auto vm = study::parse("ch3_work_precision", "4WS chapter 3 transient: run time against error", argc, argv, opts);
     const std::string out = study::outputDir(vm, "benchmarks/ch3_work_precision");
-    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    const study::Ch3Case ch3 = study::Ch3Case::fromData(ParamReader::fromFile(vm["data"].as<std::string>()));
     const double tEnd = vm["t-end-s"].as<double>();
-    const Run ref = runCh3(data, "rk_merson", vm["reference-accuracy"].as<double>(), tEnd);
-    std::printf("reference: rk_merson at %g, %d steps, %.1f s wall; final yaw rate %.9f rad/s\n\n",
-                vm["reference-accuracy"].as<double>(), ref.sum.steps, ref.sum.wall_time_s, ref.yaw.back());
-    std::printf("%-12s %9s %7s %10s %8s %11s %11s\n", "integrator", "accuracy", "steps", "wall (s)", "RTF", "err yaw",
-                "err roll");
-    std::ofstream csv(out + "/work_precision.csv");
-    csv << "integrator,accuracy,steps,wall_time_s,real_time_factor,error_yaw_rate,error_roll\n";
+    gReportInterval = requirePositive(vm["report-interval-s"].as<double>(), "--report-interval-s");
+    const double refAcc = vm["reference-accuracy"].as<double>();
+    const std::vector<std::string> models = bench::splitList(vm["models"].as<std::string>());
+    for (const auto& m : models)
+      if (m != "constrained" && m != "reduced") throw Error("--models: unknown corner model '" + m + "'");
+
+    std::map<std::string, Run> ref;
+    for (const auto& m : models) {
+      ref[m] = runCh3(ch3, m, "rk_merson", refAcc, tEnd);
+      std::printf("reference %-11s: rk_merson at %g, %d steps, %.2f s CPU; final yaw rate %.10f rad/s\n", m.c_str(),
+                  refAcc, ref[m].sum.steps, ref[m].cpu_s, ref[m].yaw.back());
+    }
+    if (ref.count("constrained") && ref.count("reduced"))
+      std::printf("references: reduced against constrained, yaw rate %.2e, roll %.2e (relative max deviation)\n",
+                  relErr(ref["reduced"].yaw, ref["constrained"].yaw), relErr(ref["reduced"].roll, ref["constrained"].roll));
+
+    // Cost per evaluation, same run, ratio to the same tree without constraint rows.
+    const int nEval = vm["cost-evaluations"].as<int>();
+    Json cost = Json::object();
+    std::printf("\n%-12s %16s %16s %8s %6s %6s\n", "model", "eval (us CPU)", "tree only (us)", "ratio", "nu", "rows");
+    for (const auto& m : models) {
+      const auto [withRows, tree] = evaluationCost(ch3, m, nEval);
+      Setup st = makeSetup(ch3, m);
+      std::printf("%-12s %16.1f %16.1f %8.2f %6d %6d\n", m.c_str(), withRows * 1e6, tree * 1e6, withRows / tree,
+                  st.initial.getNU(), st.initial.getNUDotErr());
+      cost[m] = {{"evaluation_cpu_s", withRows}, {"tree_only_cpu_s", tree}, {"ratio", withRows / tree},
+                 {"nu", st.initial.getNU()}, {"constraint_rows", st.initial.getNUDotErr()}};
+    }
+
+    // Headline: the data file's setting, models alternately, medians.
+    const int repeats = std::max(1, vm["repeats"].as<int>());
+    std::map<std::string, std::vector<double>> cpu;
+    std::map<std::string, Run> last;
+    for (int k = 0; k < repeats; ++k)
+      for (const auto& m : models) {
+        last[m] = runCh3(ch3, m, ch3.sim.integrator.method, ch3.sim.integrator.accuracy, tEnd);
+        cpu[m].push_back(last[m].cpu_s);
+      }
+    Json headline = Json::object();
+    std::printf("\nheadline: %s at %g, %d runs each (medians of CPU time)\n", ch3.sim.integrator.method.c_str(),
+                ch3.sim.integrator.accuracy, repeats);
+    std::printf("%-12s %7s %7s %10s %8s %11s %11s\n", "model", "steps", "evals", "CPU (s)", "RTF", "err yaw", "err roll");
+    for (const auto& m : models) {
+      const double med = bench::median(cpu[m]);
+      const Run& r = last[m];
+      const double ey = relErr(r.yaw, ref[m].yaw), er = relErr(r.roll, ref[m].roll);
+      std::printf("%-12s %7d %7d %10.3f %8.1f %11.2e %11.2e\n", m.c_str(), r.sum.steps, r.sum.realizations, med,
+                  r.sum.sim_time_s / med, ey, er);
+      headline[m] = {{"steps", r.sum.steps}, {"evaluations", r.sum.realizations}, {"cpu_time_s_median", med},
+                     {"cpu_time_s", cpu[m]}, {"real_time_factor", r.sum.sim_time_s / med}, {"error_yaw_rate", ey},
+                     {"error_roll", er}};
+    }
+    if (cpu.count("constrained") && cpu.count("reduced")) {
+      const double ratio = bench::median(cpu["constrained"]) / bench::median(cpu["reduced"]);
+      std::printf("same-run ratio constrained / reduced CPU time: %.2f\n", ratio);
+      headline["ratio_constrained_over_reduced"] = ratio;
+    }
+
     Json rows = Json::array();
     std::vector<study::Series> series;
-    for (const auto& m : bench::splitList(vm["integrators"].as<std::string>())) {
-      const std::string f = out + "/wp_" + m + ".csv";
-      std::ofstream o(f);
-      o << "error_yaw_rate,real_time_factor\n";
-      for (double acc : bench::splitNumbers(vm["accuracies"].as<std::string>())) {
-        const Run r = runCh3(data, m, acc, tEnd);
-        const double ey = relErr(r.yaw, ref.yaw), er = relErr(r.roll, ref.roll);
-        const double rtf = r.sum.sim_time_s / r.sum.wall_time_s;
-        std::printf("%-12s %9.0e %7d %10.3f %8.2f %11.2e %11.2e\n", m.c_str(), acc, r.sum.steps, r.sum.wall_time_s,
-                    rtf, ey, er);
-        std::fflush(stdout);
-        csv << m << ',' << acc << ',' << r.sum.steps << ',' << r.sum.wall_time_s << ',' << rtf << ',' << ey << ','
-            << er << '\n';
-        o << ey << ',' << rtf << '\n';
-        rows.push_back({{"integrator", m}, {"accuracy", acc}, {"steps", r.sum.steps},
-                        {"wall_time_s", r.sum.wall_time_s}, {"real_time_factor", rtf}, {"error_yaw_rate", ey},
-                        {"error_roll", er}});
-      }
-      series.push_back({f, "error_yaw_rate", "real_time_factor", m});
+    if (!vm.count("skip-sweep")) {
+      std::printf("\n%-12s %-12s %9s %7s %7s %10s %8s %11s %11s\n", "model", "integrator", "accuracy", "steps", "evals",
+                  "CPU (s)", "RTF", "err yaw", "err roll");
+      std::ofstream csv(out + "/work_precision.csv");
+      csv << "model,integrator,accuracy,steps,evaluations,cpu_time_s,real_time_factor,error_yaw_rate,error_roll\n";
+      for (const auto& model : models)
+        for (const auto& m : bench::splitList(vm["integrators"].as<std::string>())) {
+          const std::string f = out + "/wp_" + model + "_" + m + ".csv";
+          std::ofstream o(f);
+          o << "error_yaw_rate,real_time_factor\n";
+          for (double acc : bench::splitNumbers(vm["accuracies"].as<std::string>())) {
+            Run r;
+            try {
+              r = runCh3(ch3, model, m, acc, tEnd);
+            } catch (const Error& e) {
+              std::printf("%-12s %-12s %9.0e  failed: %s\n", model.c_str(), m.c_str(), acc, e.what());
+              continue;
+            }
+            const double ey = relErr(r.yaw, ref[model].yaw), er = relErr(r.roll, ref[model].roll);
+            const double rtf = r.sum.sim_time_s / r.cpu_s;
+            std::printf("%-12s %-12s %9.0e %7d %7d %10.3f %8.1f %11.2e %11.2e\n", model.c_str(), m.c_str(), acc,
+                        r.sum.steps, r.sum.realizations, r.cpu_s, rtf, ey, er);
+            std::fflush(stdout);
+            csv << model << ',' << m << ',' << acc << ',' << r.sum.steps << ',' << r.sum.realizations << ','
+                << r.cpu_s << ',' << rtf << ',' << ey << ',' << er << '\n';
+            o << ey << ',' << rtf << '\n';
+            rows.push_back({{"model", model}, {"integrator", m}, {"accuracy", acc}, {"steps", r.sum.steps},
+                            {"evaluations", r.sum.realizations}, {"cpu_time_s", r.cpu_s}, {"real_time_factor", rtf},
+                            {"error_yaw_rate", ey}, {"error_roll", er}});
+          }
+          series.push_back({f, "error_yaw_rate", "real_time_factor", model + " " + m});
+        }
     }
-    study::writeJson(out + "/summary.json", {{"t_end_s", tEnd}, {"points", rows}});
-    if (!vm.count("no-plots")) {
-      study::PlotSpec p{out + "/work_precision.png", "4WS chapter 3 transient: real-time factor against error",
-                        "relative error of the yaw-rate history", "real-time factor (simulated / wall s)", series};
+    study::writeJson(out + "/summary.json",
+                     {{"t_end_s", tEnd}, {"cost_per_evaluation", cost}, {"headline", headline}, {"points", rows}});
+    if (!vm.count("no-plots") && !series.empty()) {
+      study::PlotSpec p{out + "/work_precision.png", "4WS chapter 3 transient: real-time factor (CPU) against error",
+                        "relative error of the yaw-rate history", "real-time factor (simulated / CPU s)", series};
       p.logx = p.logy = p.points = true;
       study::plot({p});
     }

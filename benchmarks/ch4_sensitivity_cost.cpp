@@ -12,7 +12,7 @@
 #include "bench_util.h"
 #include "study.h"
 #include "vdyn/sensitivity/sensitivity.h"
-#include "vdyn/sensitivity/vehicle_designs.h"
+#include "vdyn/vehicles/vehicle_designs.h"
 
 using namespace vdyn;
 

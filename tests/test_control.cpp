@@ -217,7 +217,7 @@ TEST(RearSteer, TableInterpolatesInSpeedAndClamps) {
   EXPECT_EQ(test::errorOf([] {
               KrTable::fromParams(ParamReader::fromJson({{"delta_f_unit", "rad"}, {"fit", Json::array()}}, "kr.json"));
             }),
-            "kr.json: delta_f_unit: must be \"deg\", got \"rad\"");
+            "kr.json: delta_f_unit: expected \"deg\", got \"rad\"");
   EXPECT_EQ(test::errorOf([] { makeRearSteerStrategy("4ws", LinearBicycleParams{}, nullptr); }),
             "unknown rear steer strategy '4ws'; known: 2ws, linear, nonlinear");
   EXPECT_EQ(test::errorOf([] { makeRearSteerStrategy("nonlinear", LinearBicycleParams{}, nullptr); }),

@@ -1,5 +1,6 @@
 // Core: data-file errors, registry, integrator choice, recorder, scene costs.
 #include <cmath>
+#include <cstdlib>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -81,6 +82,26 @@ TEST(DataFile, MissingFileAndBadSyntaxAreNamed) {
   const std::string bad = ::testing::TempDir() + "/bad.json";
   { std::ofstream(bad) << "{ \"a\": 1, }"; }
   EXPECT_NE(errorOf([&] { ParamReader::fromFile(bad); }).find("is not valid JSON"), std::string::npos);
+}
+
+// The data search path: VDYN_DATA_PATH's folders first, in order, then (in a
+// build tree) the source tree's vehicles/data; the message lists every folder.
+TEST(DataFile, SearchPathTakesVdynDataPathFirst) {
+  const std::string dir1 = ::testing::TempDir() + "/vdyn_data_a", dir2 = ::testing::TempDir() + "/vdyn_data_b";
+  ASSERT_EQ(std::system(("mkdir -p " + dir1 + " " + dir2).c_str()), 0);
+  { std::ofstream(dir2 + "/appendix_a.json") << "{\"from\": \"b\"}"; }
+  ASSERT_EQ(setenv("VDYN_DATA_PATH", (dir1 + ":" + dir2).c_str(), 1), 0);
+  const std::vector<std::string> path = dataSearchPath();
+  const std::string found = resolveDataPath("appendix_a.json");
+  const std::string missing = errorOf([] { resolveDataPath("no_such_vehicle.json"); });
+  unsetenv("VDYN_DATA_PATH");
+  ASSERT_EQ(path.size(), 3u);
+  EXPECT_EQ(path[0], dir1);
+  EXPECT_EQ(path[1], dir2);
+  EXPECT_EQ(path[2].substr(path[2].size() - 13), "vehicles/data");
+  EXPECT_EQ(found, dir2 + "/appendix_a.json");  // ahead of the project's own appendix_a.json
+  EXPECT_NE(missing.find(dir1 + ", " + dir2 + ", " + path[2]), std::string::npos) << missing;
+  EXPECT_EQ(dataSearchPath().size(), 1u);  // without the variable: the data folder alone
 }
 
 TEST(Registry, DuplicateAndUnknownNames) {

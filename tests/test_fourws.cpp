@@ -27,7 +27,7 @@ TEST(FourWs, ModelSizeWithoutSteering) {
 
 TEST(FourWs, TotalMassIsTableA1) {
   const FourWsVehicle car(appendixA());
-  // 800 + 2 (0.5 + 5 + 0.5 + 20) + 2 (0.5 + 5 + 0.5 + 30) = 924 kg (DESIGN.md section 9).
+  // 800 + 2 (0.5 + 5 + 0.5 + 20) + 2 (0.5 + 5 + 0.5 + 30) = 924 kg (docs/vehicle_data.md).
   EXPECT_DOUBLE_EQ(car.totalMass(), 924.0);
 }
 

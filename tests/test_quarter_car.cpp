@@ -29,7 +29,7 @@ TEST(QuarterCar, AssemblyClosesTheTabulatedLoop) {
   const QuarterCar car(nominal());
   AssemblyReport rep;
   const SimTK::State s = car.makeInitialState(false, &rep);
-  // DESIGN.md section 9: the printed front corner is open by about 4 cm.
+  // docs/vehicle_data.md: the printed front corner is open by about 4 cm.
   EXPECT_NEAR(rep.initial_loop_gap_m, 0.040, 0.002);
   EXPECT_LT(positionConstraintError(s), 1e-10);
   EXPECT_GT(rep.max_move_m, 0.0);

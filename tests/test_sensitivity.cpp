@@ -11,7 +11,7 @@
 #include "vdyn/core/simulation.h"
 #include "vdyn/sensitivity/mixed.h"
 #include "vdyn/sensitivity/sensitivity.h"
-#include "vdyn/sensitivity/vehicle_designs.h"
+#include "vdyn/vehicles/vehicle_designs.h"
 
 using namespace vdyn;
 

@@ -12,6 +12,7 @@
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
+#include "vdyn/steering_ratio/linear_ratio.h"
 #include "vdyn/vehicles/bicycle.h"
 #include "vdyn/vehicles/fourws.h"
 
@@ -45,16 +46,16 @@ BikeCase makeBike(const std::string& tire, double U, double delta) {
   return c;
 }
 
-/// Linear bicycle (6.1)-(6.9), two tires per axle.
-struct LinearBicycle {
-  double M, a, b, L, C;
-  double understeer() const { return M / L * (b / C - a / C); }
-  double yawRate(double U, double d) const { return U * d / (L + understeer() * U * U); }
-  double sideSlip(double U, double d) const { return d * (b - M * a * U * U / (C * L)) / (L + understeer() * U * U); }
-};
-LinearBicycle linearOf(const Bicycle& bike) {
-  const double a = bike.distanceToFrontAxle(), b = bike.distanceToRearAxle();
-  return {bike.totalMass(), a, b, a + b, 2 * bike.params().tire.cornering_stiffness_N_per_rad};
+/// The bicycle as the linear bicycle (6.1)-(6.9) of vdyn/steering_ratio/linear_ratio.h,
+/// two tires per axle.
+LinearBicycleParams linearOf(const Bicycle& bike) {
+  LinearBicycleParams p;
+  p.mass_kg = bike.totalMass();
+  p.front_axle_to_com_m = bike.distanceToFrontAxle();
+  p.rear_axle_to_com_m = bike.distanceToRearAxle();
+  p.front_cornering_stiffness_N_per_rad = p.rear_cornering_stiffness_N_per_rad =
+      2 * bike.params().tire.cornering_stiffness_N_per_rad;
+  return p;
 }
 
 /// Side slip of the whole vehicle's centre of mass (the linear bicycle's point).
@@ -70,13 +71,13 @@ TEST(SteadyState, LinearTireBicycleMatchesTheClosedForm) {
   const double U = 10.0, d = 0.5 * kDeg;
   BikeCase c = makeBike("linear", U, d);
   const SteadyStateResult r = c.solver->solve(c.start);
-  const LinearBicycle lin = linearOf(*c.bike);
+  const LinearBicycleParams lin = linearOf(*c.bike);
   const double yaw = c.bike->getScene().evalOutput("chassis.yaw_rate_rad_s", r.state);
   const double beta = comSideSlip(*c.bike, r.state);
-  std::printf("yaw rate %.8f (closed form %.8f), side slip %.8f (%.8f), %d iterations\n", yaw, lin.yawRate(U, d), beta,
-              lin.sideSlip(U, d), r.iterations);
-  EXPECT_NEAR(yaw, lin.yawRate(U, d), 0.01 * lin.yawRate(U, d));
-  EXPECT_NEAR(beta, lin.sideSlip(U, d), 0.01 * std::abs(lin.sideSlip(U, d)));
+  std::printf("yaw rate %.8f (closed form %.8f), side slip %.8f (%.8f), %d iterations\n", yaw, calcLinearSteadyYawRate(lin, U, d, 0), beta,
+              calcLinearSteadySideSlip(lin, U, d, 0), r.iterations);
+  EXPECT_NEAR(yaw, calcLinearSteadyYawRate(lin, U, d, 0), 0.01 * calcLinearSteadyYawRate(lin, U, d, 0));
+  EXPECT_NEAR(beta, calcLinearSteadySideSlip(lin, U, d, 0), 0.01 * std::abs(calcLinearSteadySideSlip(lin, U, d, 0)));
   // The residual at the solution is below the tolerances.
   EXPECT_LE(r.force_residual, c.solver->options().force_tolerance);
   EXPECT_LE(r.position_error, c.solver->options().position_tolerance);
@@ -121,9 +122,9 @@ TEST(SteadyState, StabilityVerdictFindsTheLinearCriticalSpeed) {
   // a > b with equal axle stiffnesses: the bicycle oversteers, and the linear
   // bicycle is unstable above U_crit = sqrt(L^2 C / (M (a - b))).
   BikeCase probe = makeBike("linear", 10.0, 0.01 * kDeg);
-  const LinearBicycle lin = linearOf(*probe.bike);
-  ASSERT_GT(lin.a, lin.b);
-  const double Ucrit = std::sqrt(-lin.L / lin.understeer());
+  const LinearBicycleParams lin = linearOf(*probe.bike);
+  ASSERT_GT(lin.front_axle_to_com_m, lin.rear_axle_to_com_m);
+  const double Ucrit = std::sqrt(-lin.wheelbase_m() / lin.understeerGradient());
   std::printf("linear critical speed %.3f m/s\n", Ucrit);
   for (double f : {0.9, 1.1}) {
     BikeCase c = makeBike("linear", f * Ucrit, 0.01 * kDeg);
@@ -161,8 +162,8 @@ TEST(SteadyState, SensitivityOfYawRateToSteeringMatchesTheClosedForm) {
   const auto dr = calcSteadyStateSensitivity(
       *c.solver, r, d, 1.0 * kDeg, [&](SimTK::State&, double v) { c.steer->setAngle(v); },
       [&](const SimTK::State& s) { return std::vector<double>{c.bike->getScene().evalOutput("chassis.yaw_rate_rad_s", s)}; });
-  const LinearBicycle lin = linearOf(*c.bike);
-  const double closed = U / (lin.L + lin.understeer() * U * U);
+  const LinearBicycleParams lin = linearOf(*c.bike);
+  const double closed = calcLinearSteadyYawRate(lin, U, 1.0, 0);
   std::printf("d r / d delta = %.6f (closed form %.6f)\n", dr[0], closed);
   EXPECT_NEAR(dr[0], closed, 0.01 * closed);
   EXPECT_DOUBLE_EQ(c.steer->getAngle(), d);  // the nominal condition is restored

@@ -153,8 +153,8 @@ TEST(TireSaturation, FialaLateralIsMuMinFzAndLockedWheelFollowsThePublishedLaw) 
   }
 }
 
-// --- Gim in combined slip against DESIGN.md section 8 ---------------------------------
-// An independent evaluation of the section-8 formulas, written with the slip angle
+// --- Gim in combined slip against docs/equations.md "Tire: Gim" -----------------------
+// An independent evaluation of those formulas, written with the slip angle
 // and cos/sin(theta) instead of the model's ratios: braking S_s = (Vx - Omega Re) / Vx,
 // S_a = |tan alpha|; driving S_s = (Omega Re - Vx) / (Omega Re), S_a = (1 - S_s) |tan alpha|;
 // mu linear in S = |(S_s, S_a)|; l_n = 1 - |(C_s S_s, C_a S_a)| / (3 mu Fz) in [0, 1].

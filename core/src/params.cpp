@@ -1,14 +1,16 @@
 #include "vdyn/core/params.h"
 
 #include <algorithm>
+#include <climits>
+#include <cstdlib>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <mutex>
 #include <set>
 #include <sstream>
-#include <climits>
-#include <cstdlib>
-#include <functional>
+
+#include <dlfcn.h>
 #include <sys/stat.h>
 
 namespace vdyn {
@@ -139,13 +141,47 @@ Json readJsonFile(const std::string& path) {
   return parseJsonText(text.str(), "data file '" + path + "'");
 }
 
+std::vector<std::string> dataSearchPath() {
+  std::vector<std::string> dirs;
+  if (const char* env = std::getenv("VDYN_DATA_PATH")) {
+    std::string list(env);
+    size_t start = 0;
+    while (start <= list.size()) {
+      const size_t end = std::min(list.find(':', start), list.size());
+      if (end > start) dirs.push_back(list.substr(start, end - start));
+      start = end + 1;
+    }
+  }
+  // The object file holding this function: libvdyn_core.so (or the program,
+  // for a static build); the installed data folder is relative to it.
+  std::string installed;
+  Dl_info info;
+  if (dladdr(reinterpret_cast<void*>(&dataSearchPath), &info) != 0 && info.dli_fname != nullptr) {
+    std::string lib(info.dli_fname);
+    const size_t slash = lib.find_last_of('/');
+    installed = (slash == std::string::npos ? std::string(".") : lib.substr(0, slash)) + "/" + VDYN_LIB_TO_DATA;
+  }
+  struct stat st;
+  if (!installed.empty() && stat(installed.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    dirs.push_back(installed);
+  else
+    dirs.push_back(VDYN_BUILD_DATA_DIR);
+  return dirs;
+}
+
 std::string resolveDataPath(const std::string& name) {
   struct stat st;
   if (stat(name.c_str(), &st) == 0) return name;
-  const std::string inData = std::string(VDYN_DATA_DIR) + "/" + name;
-  if (stat(inData.c_str(), &st) == 0) return inData;
-  throw Error("data file '" + name + "' not found (looked in the working directory and " +
-              VDYN_DATA_DIR + ")");
+  const std::vector<std::string> dirs = dataSearchPath();
+  std::string looked = "the working directory";
+  if (name.empty() || name[0] != '/') {
+    for (const std::string& dir : dirs) {
+      const std::string candidate = dir + "/" + name;
+      if (stat(candidate.c_str(), &st) == 0) return candidate;
+      looked += ", " + dir;
+    }
+  }
+  throw Error("data file '" + name + "' not found (looked in " + looked + ")");
 }
 
 struct ParamReader::Tracker {

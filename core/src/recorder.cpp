@@ -14,23 +14,55 @@ Recorder::Recorder(const Scene& scene, std::vector<std::string> names)
   columns_.resize(names_.size());
 }
 
+void Recorder::syncWorkspace(const SimTK::State& like) {
+  // Discrete variables (Instance stage and below) change the stage versions;
+  // only then is a whole State copied.
+  SimTK::Array_<SimTK::StageVersion> v;
+  like.getSystemStageVersions(v);
+  bool same = haveWork_ && v.size() == workVersions_.size();
+  for (int k = 0; same && k <= SimTK::Stage::Instance && k < int(v.size()); ++k) same = v[k] == workVersions_[k];
+  if (!same) {
+    work_ = like;
+    workVersions_ = v;
+    haveWork_ = true;
+  }
+}
+
 void Recorder::record(const SimTK::State& state) {
   const SimTK::State* s = &state;
   if (state.getSystemStage() < stage_) {
-    if (!haveWork_) {
-      work_ = state;
-      haveWork_ = true;
-    } else {
-      work_.setTime(state.getTime());
-      work_.updQ() = state.getQ();
-      work_.updU() = state.getU();
-      work_.updZ() = state.getZ();
-    }
+    syncWorkspace(state);
+    work_.setTime(state.getTime());
+    work_.updY() = state.getY();
     scene_.getSystem().realize(work_, stage_);
     s = &work_;
   }
   time_.push_back(s->getTime());
   for (std::size_t i = 0; i < outputs_.size(); ++i) columns_[i].push_back(outputs_[i]->eval(*s));
+}
+
+void Recorder::recordInterpolated(double t, double t0, const SimTK::Vector& y0, const SimTK::Vector& f0,
+                                  const SimTK::State& end) {
+  const double t1 = end.getTime();
+  assert(t0 < t1 && t0 <= t && t <= t1);
+  syncWorkspace(end);
+  const SimTK::Vector& y1 = end.getY();
+  const SimTK::Vector& f1 = end.getYDot();
+  // Simbody's IntegratorRep::interpolateOrder3 (cubic Hermite, error O(h^4)).
+  const double h = t1 - t0, d = (t - t0) / h;
+  const double cy1 = d * d * (3 - 2 * d), cy0 = 1 - cy1;
+  const double hdd1 = h * d * (d - 1), cf1 = hdd1 * d, cf0 = cf1 - hdd1;
+  work_.setTime(t);
+  SimTK::Vector& y = work_.updY();
+  for (int i = 0; i < y.size(); ++i) y[i] = cy0 * y0[i] + cy1 * y1[i] + cf0 * f0[i] + cf1 * f1[i];
+  const SimTK::System& system = scene_.getSystem();
+  system.realize(work_, SimTK::Stage::Time);
+  system.prescribeQ(work_);
+  system.realize(work_, SimTK::Stage::Position);
+  system.prescribeU(work_);
+  if (stage_ > SimTK::Stage::Position) system.realize(work_, stage_);
+  time_.push_back(t);
+  for (std::size_t i = 0; i < outputs_.size(); ++i) columns_[i].push_back(outputs_[i]->eval(work_));
 }
 
 const std::vector<double>& Recorder::column(const std::string& name) const {

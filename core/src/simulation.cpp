@@ -92,6 +92,46 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   auto nextReport = [&] { return std::min(s.t_end_s, t0 + k * s.report_interval_s); };
   if (reporting) recorder->record(integ->getState());
   double lastReported = t0;
+  // Reporting without State copies: the Runge-Kutta family (Simbody's
+  // AbstractIntegratorRep) steps to t_end and the recorder evaluates the
+  // integrator's own cubic Hermite interpolant of each step (previous Y and
+  // YDot kept here, two vectors) in one reused workspace state, unprojected
+  // (the samples read positions and velocities, no constraint needs them
+  // exact). CPodes interpolates with its own polynomial: it stops at report
+  // times and its interpolated states are not projected either.
+  const bool ownInterpolation = reporting && s.integrator.method != "cpodes";
+  if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
+  SimTK::Vector yPrev, ydotPrev;
+  double tPrev = t0;
+  int ownRealizations = 0;
+  if (ownInterpolation) {
+    const SimTK::State& s0 = integ->getState();
+    scene.getSystem().realize(s0, SimTK::Stage::Acceleration);
+    yPrev = s0.getY();
+    ydotPrev = s0.getYDot();
+  }
+  // Samples the report times in (tPrev, end of the step just taken].
+  auto sampleStep = [&](const SimTK::State& adv) {
+    const double t1 = adv.getTime();
+    if (!(t1 > tPrev)) return;
+    // The next step's first stage (the integrator then finds it done and does
+    // not count it): counted here, so `realizations` stays the number of
+    // forward-dynamics evaluations.
+    if (adv.getSystemStage() < SimTK::Stage::Acceleration) {
+      scene.getSystem().realize(adv, SimTK::Stage::Acceleration);
+      ++ownRealizations;
+    }
+    const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
+    while (lastReported < s.t_end_s - tEndTol && nextReport() <= t1 + tEndTol) {
+      const double tr = std::min(nextReport(), t1);
+      recorder->recordInterpolated(tr, tPrev, yPrev, ydotPrev, adv);
+      lastReported = tr;
+      ++k;
+    }
+    yPrev = adv.getY();
+    ydotPrev = adv.getYDot();
+    tPrev = t1;
+  };
 
   // Simbody 3.7's CPodes can step past the final time and then never report
   // EndOfSimulation (simbody issue #824, fixed after 3.7), so the loop also ends
@@ -111,12 +151,13 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   for (;;) {
     SimTK::Integrator::SuccessfulStepStatus status;
     try {
-      status = integ->stepTo(reporting ? nextReport() : s.t_end_s);
+      status = integ->stepTo(reporting && !ownInterpolation ? nextReport() : s.t_end_s);
     } catch (const std::exception& e) {
       throw Error("simulate: " + s.integrator.method + " failed at t = " +
                   formatValue(integ->getTime()) + " s: " + e.what());
     }
     using S = SimTK::Integrator;
+    if (ownInterpolation) sampleStep(integ->getAdvancedState());
     if (status == S::TimeHasAdvanced) {
       const SimTK::State& adv = integ->getAdvancedState();
       sum.max_constraint_error = std::max(sum.max_constraint_error, positionConstraintError(adv));
@@ -139,7 +180,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         }
       }
     } else if (status == S::ReachedReportTime) {
-      if (reporting) {
+      if (reporting && !ownInterpolation) {
         recorder->record(integ->getState());
         lastReported = integ->getTime();
         ++k;
@@ -159,7 +200,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   state = integ->getState();
   sum.steps = integ->getNumStepsTaken();
   sum.attempts = integ->getNumStepsAttempted();
-  sum.realizations = integ->getNumRealizations();
+  sum.realizations = integ->getNumRealizations() + ownRealizations;
   sum.projections = integ->getNumProjections();
   sum.sim_time_s = s.t_end_s - t0;
   sum.wall_time_s =

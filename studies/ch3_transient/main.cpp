@@ -115,6 +115,8 @@ int main(int argc, char** argv) {
                     {"wall_time_s", run.wall_time_s},
                     {"real_time_factor", run.sim_time_s / run.wall_time_s},
                     {"steps", run.steps},
+                    {"evaluations", run.realizations},
+                    {"corner_model", car.params().corner_model},
                     {"integrator", run.integrator},
                     {"accuracy", run.accuracy},
                     {"assembly_max_body_move_m", assembly.max_move_m}};
@@ -145,8 +147,10 @@ int main(int argc, char** argv) {
                 fin("chassis.side_slip_rad"), fin("speed_hold.force_N"));
     std::printf("  wheel spins         RF %.4f LF %.4f RR %.4f LR %.4f rad/s\n", fin("rf.spin_rad_s"),
                 fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s"));
-    std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, max |steer - command| %.2e rad, %d steps\n", dof,
-                car.totalMass(), run.max_constraint_error, steerError, run.steps);
+    std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, max |steer - command| %.2e rad, %d steps, "
+                "%d evaluations (%s corners)\n",
+                dof, car.totalMass(), run.max_constraint_error, steerError, run.steps, run.realizations,
+                car.params().corner_model.c_str());
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
     if (!verdict.steady)

@@ -10,7 +10,7 @@
 
 #include "study.h"
 #include "vdyn/sensitivity/sensitivity.h"
-#include "vdyn/sensitivity/vehicle_designs.h"
+#include "vdyn/vehicles/vehicle_designs.h"
 
 using namespace vdyn;
 

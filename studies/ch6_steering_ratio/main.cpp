@@ -1,5 +1,5 @@
 // ch6_steering_ratio: the seed's optimal 4WS steering ratio Kr = delta_r /
-// delta_f (chapters 5-6, 8.1; DESIGN.md section 5), plugins/steering_ratio:
+// delta_f (chapters 5-6, 8.1; docs/equations.md "Steering ratio"), plugins/steering_ratio:
 //  - Figure 6.2: the linear bicycle's Kr(U) (6.9) for U = 2..35 m/s, from
 //    vehicles/data/ch6_linear_bicycle.json (the seed's chapter-6 constants);
 //  - Figure 6.4: the App. A vehicle's optimal Kr (6.12)-(6.15) over front angles

@@ -1,4 +1,4 @@
-// ch8_maneuvers: the seed's chapter 8 comparison (DESIGN.md section 7): the
+// ch8_maneuvers: the seed's chapter 8 comparison (docs/equations.md "Manoeuvres"): the
 // App. A 4WS vehicle at constant speed follows three lane changes and two
 // J-turns with the path controller (7.9)-(7.18) on the front wheels, under
 // three rear-steer strategies (8.1)-(8.8): 2ws, linear (Kr of the linear
@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
         "scenario", po::value<std::string>(), "comma-separated scenario ids to run (default: all)")(
         "strategy", po::value<std::string>(), "comma-separated strategies: 2ws, linear, nonlinear (default: all)")(
         "lane-change-length", po::value<std::string>(),
-        "how the seed's lane-change distance reads: 'full' (DESIGN.md: the whole lane change, X_f - X_0) or "
+        "how the seed's lane-change distance reads: 'full' (the whole lane change, X_f - X_0; docs/equations.md) or "
         "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
         "no-plots", "skip the PNG plots");
     study::addIntegratorOptions(opts);

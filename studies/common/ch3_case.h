@@ -21,6 +21,8 @@ struct Ch3Case {
   double front_rad = 0, rear_rad = 0;  ///< final steering angles, rad (+ left)
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
   SimulationSettings sim;            ///< the data file's "simulation"
+  /// "constrained" or "reduced" overrides the vehicle file's corner_model; empty keeps it.
+  std::string corner_model;
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
   /// --integrator, --accuracy.
@@ -28,7 +30,10 @@ struct Ch3Case {
     opts.add_options()("speed-m-s", po::value<double>(), "constant forward speed U0, m/s (seed: 10)")(
         "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
         "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
-        "t-end-s", po::value<double>(), tEndHelp.c_str());
+        "t-end-s", po::value<double>(), tEndHelp.c_str())(
+        "corner-model", po::value<std::string>(),
+        "constrained (loops closed by constraints, the reference) or reduced (loops solved in the tree); "
+        "default: the vehicle file's corner_model");
     addIntegratorOptions(opts);
   }
 
@@ -58,6 +63,7 @@ struct Ch3Case {
     c.sim.report_interval_s = dt.value;
     c.sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
     if (vm) applyIntegratorOptions(*vm, c.sim.integrator);
+    if (v.count("corner-model")) c.corner_model = v["corner-model"].as<std::string>();
     // semi_explicit_euler2's error estimate does not bound the error of this
     // scene: at accuracy 1e-3 (0.5 m/s, 2 deg) it ended at a yaw rate of
     // -0.129 rad/s against 0.0078 from every other integrator (issue 12; the
@@ -75,8 +81,14 @@ struct Ch3Case {
   double settledTime() const { return steer_start_s + steer_duration_s; }
 
   /// The vehicle with its steering ("front_steer", "rear_steer") and speed hold ("speed_hold").
-  std::unique_ptr<FourWsVehicle> buildVehicle() const {
-    auto car = std::make_unique<FourWsVehicle>(FourWsParams::fromFile(vehicle_data));
+  /// `cornerModel` (if not empty) overrides corner_model.
+  std::unique_ptr<FourWsVehicle> buildVehicle(const std::string& cornerModel = "") const {
+    FourWsParams p = FourWsParams::fromFile(vehicle_data);
+    if (!corner_model.empty()) p.corner_model = corner_model;
+    if (!cornerModel.empty()) p.corner_model = cornerModel;
+    if (p.corner_model != "constrained" && p.corner_model != "reduced")
+      throw Error("--corner-model must be constrained or reduced, got '" + p.corner_model + "'");
+    auto car = std::make_unique<FourWsVehicle>(p);
     car->addAxleSteering("front_steer", true,
                          std::make_shared<SmoothStepCommand>(0, front_rad, steer_start_s, steer_duration_s));
     car->addAxleSteering("rear_steer", false,

@@ -1,5 +1,5 @@
 #pragma once
-// Conventions every study follows (DESIGN.md section 10): options with units in
+// Conventions every study follows (docs/conventions.md "Studies"): options with units in
 // their names, --out DIR (default results/<study>/), summary.json, CSV with a
 // header row, PNG plots, a printed table, exit 0 on success and non-zero with a
 // one-line message on a user error or numerical failure.

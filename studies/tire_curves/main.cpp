@@ -1,5 +1,5 @@
 // tire_curves: steady-state characteristics of the App. A tire (Table A.4) with the
-// Gim (DESIGN.md section 8) and Fiala (section 11) laws, evaluated on their own
+// Gim and Fiala (docs/equations.md "Tire: Gim", "Tire: Fiala") laws, evaluated on their own
 // (no multibody model): lateral force against slip angle in pure lateral slip,
 // longitudinal force against slip ratio in pure longitudinal slip, and combined
 // slip at 4000 N. Writes lateral.csv, longitudinal.csv, combined.csv (plus wide

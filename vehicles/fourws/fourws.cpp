@@ -23,6 +23,8 @@ void FourWsParams::validate() const {
   makeRoad(road);
   requireNonNegative(gravity_m_per_s2, "4ws gravity_m_per_s2");
   if (tire_plugin.empty()) throw Error("4ws tire plugin name is empty");
+  if (corner_model != "constrained" && corner_model != "reduced")
+    throw Error("4ws corner_model must be \"constrained\" or \"reduced\", got \"" + corner_model + "\"");
 }
 
 FourWsParams FourWsParams::fromParams(const ParamReader& r) {
@@ -35,6 +37,9 @@ FourWsParams FourWsParams::fromParams(const ParamReader& r) {
   p.tire = TireParams::fromParams(tire.child("params"));
   if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
   p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
+  p.corner_model = r.stringOr("corner_model", p.corner_model);
+  if (p.corner_model != "constrained" && p.corner_model != "reduced")
+    throw Error(r.where() + ": corner_model must be \"constrained\" or \"reduced\", got \"" + p.corner_model + "\"");
   r.requireAllKeysRead();
   p.validate();
   return p;
@@ -48,6 +53,8 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
     : p_(params), scene_(std::make_unique<Scene>()) {
   p_.validate();
   Scene& sc = *scene_;
+  reduced_ = p_.corner_model == "reduced";
+  if (reduced_) registry_ = std::make_shared<PluginRegistry>(registry);
   SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
   chassis_ = SimTK::MobilizedBody::Free(
       sc.updMatter().Ground(), SimTK::Transform(),
@@ -59,24 +66,39 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
   const Json tireJson = p_.tire.toJson();
   for (int c = 0; c < 4; ++c) {
     const std::string prefix = std::string(cornerName(c)) + ".";
-    corners_[c] = buildDoubleWishbone(sc, chassis_, cornerParams_[c], prefix);
+    if (reduced_) {
+      loops_[c] = std::make_unique<WishboneLoop>(cornerParams_[c]);
+      reducedCorners_[c] = buildReducedWishbone(sc, chassis_, cornerParams_[c], *loops_[c], prefix);
+    } else {
+      corners_[c] = buildDoubleWishbone(sc, chassis_, cornerParams_[c], prefix);
+    }
     const PluginSpec spec{std::string("tire_") + cornerName(c),
                           ParamReader::fromJson(Json{{"params", tireJson}}, "4ws tire"),
                           {{"wheel", prefix + "wheel"}}};
     tires_[c] = dynamic_cast<const TirePlugin*>(
         &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire_plugin, spec, "4ws tire plugin")));
     if (!tires_[c]) throw Error("4ws tire plugin '" + p_.tire_plugin + "' is not a tire plugin");
-    const auto wheel = corners_[c].wheel;
+    const SimTK::MobilizedBody wheel = sc.getBody(prefix + "wheel");
     sc.addOutput({prefix + "spin_rad_s", "rad/s", SimTK::Stage::Velocity,
                   [wheel](const SimTK::State& s) { return wheel.getOneU(s, 0); }});
   }
 
+  if (reduced_) {  // every arm row in one constraint object
+    std::vector<ArmPlanesImpl::Row> rows;
+    for (int c = 0; c < 4; ++c) {
+      const auto r = armPlaneRows(cornerParams_[c], reducedCorners_[c].lower_arm, reducedCorners_[c].knuckle,
+                                  reducedCorners_[c].upper_arm);
+      rows.insert(rows.end(), r.begin(), r.end());
+    }
+    SimTK::Constraint::Custom(new ArmPlanesImpl(sc.updMatter(), rows));
+  }
   addChassisOutputs(sc, chassis_);
 }
 
 const SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bool front,
                                                      std::shared_ptr<const SteeringCommand> command) {
   const int r = front ? RF : RR, l = front ? LF : LR;
+  axleSteering_.push_back({name, front, command, 0.0});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{std::string(cornerName(r)) + ".knuckle", std::string(cornerName(l)) + ".knuckle"},
       std::move(command), SimTK::UnitVec3(cornerParams_[r].wheel_spin_axis));
@@ -85,6 +107,7 @@ const SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bo
 
 SteeringPlugin& FourWsVehicle::addAxleSteering(const std::string& name, bool front, const SteeringStateSpec& state) {
   const int r = front ? RF : RR, l = front ? LF : LR;
+  axleSteering_.push_back({name, front, nullptr, state.initial_angle_rad});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{std::string(cornerName(r)) + ".knuckle", std::string(cornerName(l)) + ".knuckle"},
       state, SimTK::UnitVec3(cornerParams_[r].wheel_spin_axis));
@@ -117,21 +140,41 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
   std::vector<std::pair<std::string, SimTK::MobilizedBody>> bodies;
   for (int c = 0; c < 4; ++c) {
     const std::string n = cornerName(c);
-    bodies.push_back({n + ".lower_arm", corners_[c].lower_arm});
-    bodies.push_back({n + ".knuckle", corners_[c].knuckle});
-    bodies.push_back({n + ".upper_arm", corners_[c].upper_arm});
-    bodies.push_back({n + ".wheel", corners_[c].wheel});
+    for (const char* b : {".lower_arm", ".knuckle", ".upper_arm", ".wheel"})
+      bodies.push_back({n + b, scene_->getBody(n + b)});
   }
-  double gap = 0;
+  double gap = 0;  // the reduced loop is closed by construction
+  AssemblyReport conReport;
+  if (reduced_) {
+    // The constrained model's assembly (same data, axle steering held at its
+    // initial angles), read into the reduced coordinates.
+    FourWsParams cp = p_;
+    cp.corner_model = "constrained";
+    FourWsVehicle con(cp, *registry_);
+    for (const AxleSteering& a : axleSteering_)
+      con.addAxleSteering(a.name, a.front,
+                          std::make_shared<HoldCommand>(a.command ? a.command->calcAt(s.getTime()).angle_rad
+                                                                  : a.initial_angle_rad));
+    const SimTK::State cs = con.makeInitialState(0.0, &conReport);
+    chassis_.setQ(s, con.chassis().getQ(cs));
+    for (int c = 0; c < 4; ++c) {
+      const SimTK::UnitVec3 spin(cornerParams_[c].wheel_spin_axis);
+      setReducedCornerPosition(s, reducedCorners_[c], con.suspensionAngle(cs, c),
+                               steeringAngle(cs, con.chassis(), con.corner(c).knuckle, spin));
+    }
+    gap = conReport.initial_loop_gap_m;
+  }
+  std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex()};
   for (int c = 0; c < 4; ++c) {
+    locked.push_back(scene_->getBody(std::string(cornerName(c)) + ".wheel").getMobilizedBodyIndex());
+    if (reduced_) continue;
     const auto& j = cornerParams_[c].upper_ball;
     gap = std::max(gap, (corners_[c].upper_arm.findStationLocationInGround(s, j.parent_point_m) -
                          corners_[c].knuckle.findStationLocationInGround(s, j.child_point_m)).norm());
   }
-  std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex()};
-  for (const auto& c : corners_) locked.push_back(c.wheel.getMobilizedBodyIndex());
   for (auto mbx : steeringStateBodies(*scene_)) locked.push_back(mbx);  // keep delta at its initial value
   assembleLoops(system, s, locked, bodies, gap, "4ws", report);
+  if (reduced_ && report) *report = conReport;  // the moves that made this configuration
   // Moving forward with every body at the chassis velocity and the wheels rolling.
   s.updU() = 0;
   chassis_.setUToFitLinearVelocity(s, Vec3(speed, 0, 0));
@@ -143,9 +186,69 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
     const ContactKinematics k = tires_[c]->calcContact(s).kinematics;
     spin[c] = k.vx_m_s / tires_[c]->getForceElement().getModel().calcRollingRadius(k.deflection_m);
   }
-  for (int c = 0; c < 4; ++c) corners_[c].wheel.setOneU(s, 0, spin[c]);
+  for (int c = 0; c < 4; ++c) scene_->getBody(std::string(cornerName(c)) + ".wheel").setOneU(s, 0, spin[c]);
   system.realize(s, SimTK::Stage::Velocity);
   for (const TirePlugin* t : tires_) t->getForceElement().initializeRelaxationStates(s);
+  return s;
+}
+
+const DoubleWishboneCorner& FourWsVehicle::corner(int c) const {
+  if (reduced_) throw Error("4ws: corner() is the constrained model's; this vehicle is reduced (use reducedCorner())");
+  return corners_.at(c);
+}
+
+const ReducedWishboneCorner& FourWsVehicle::reducedCorner(int c) const {
+  if (!reduced_) throw Error("4ws: reducedCorner() on a constrained vehicle (corner_model \"constrained\")");
+  return reducedCorners_.at(c);
+}
+
+double FourWsVehicle::suspensionAngle(const SimTK::State& s, int c) const {
+  return scene_->getBody(std::string(cornerName(c)) + ".lower_arm").getOneQ(s, 0);
+}
+
+SimTK::State FourWsVehicle::makeStateLike(const FourWsVehicle& other, const SimTK::State& os) const {
+  if (!reduced_) throw Error("4ws: makeStateLike() builds a reduced model's state; this vehicle is constrained");
+  const SimTK::MultibodySystem& system = scene_->getSystem();
+  const Scene& osc = other.getScene();
+  osc.getSystem().realize(os, SimTK::Stage::Velocity);
+  SimTK::State s = scene_->getDefaultState();
+  s.setTime(os.getTime());
+  chassis_.setQ(s, other.chassis().getQ(os));
+  chassis_.setU(s, other.chassis().getU(os));
+  for (int c = 0; c < 4; ++c) {
+    const std::string n = cornerName(c);
+    const SimTK::MobilizedBody& ok = osc.getBody(n + ".knuckle");
+    const SimTK::UnitVec3 spin(cornerParams_[c].wheel_spin_axis);
+    // (A.1) angle and its rate: x . f = -sin(delta), d/dt (x . f) = (w_K - w_C) . (f x x).
+    const SimTK::Vec3 x = other.chassis().getBodyRotation(os).x();
+    const SimTK::Vec3 f = ok.getBodyRotation(os) * spin.asVec3();
+    const double delta = std::asin(-SimTK::dot(x, f));
+    const double xfdot = SimTK::dot(ok.getBodyAngularVelocity(os) - other.chassis().getBodyAngularVelocity(os),
+                                    SimTK::cross(f, x));
+    const double sAng = other.suspensionAngle(os, c);
+    setReducedCornerPosition(s, reducedCorners_[c], sAng, delta);
+    const double sRate = osc.getBody(n + ".lower_arm").getOneU(os, 0);
+    const double deltaRate = -xfdot / std::cos(delta);
+    reducedCorners_[c].knuckle.setOneU(s, 0, sRate);
+    reducedCorners_[c].knuckle.setOneU(s, 1, deltaRate);
+    reducedCorners_[c].lower_arm.setOneU(s, 0, sRate);
+    reducedCorners_[c].upper_arm.setOneU(s, 0, loops_[c]->calcUpperArmAngle(sAng)[1] * sRate);
+    const SimTK::MobilizedBody& ow = osc.getBody(n + ".wheel");
+    reducedCorners_[c].wheel.setOneQ(s, 0, ow.getOneQ(os, 0));
+    reducedCorners_[c].wheel.setOneU(s, 0, ow.getOneU(os, 0));
+  }
+  // State-driven steer bodies (same plugins, same order) and z variables.
+  const auto mine = steeringStateBodies(*scene_), theirs = steeringStateBodies(osc);
+  if (mine.size() != theirs.size()) throw Error("4ws makeStateLike: the vehicles have different steering plugins");
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    scene_->getMatter().getMobilizedBody(mine[i]).setOneQ(s, 0, osc.getMatter().getMobilizedBody(theirs[i]).getOneQ(os, 0));
+    scene_->getMatter().getMobilizedBody(mine[i]).setOneU(s, 0, osc.getMatter().getMobilizedBody(theirs[i]).getOneU(os, 0));
+  }
+  if (s.getNZ() != os.getNZ()) throw Error("4ws makeStateLike: the vehicles have different z variables");
+  s.updZ() = os.getZ();
+  system.realize(s, SimTK::Stage::Position);
+  system.project(s, 1e-12);
+  system.realize(s, SimTK::Stage::Velocity);
   return s;
 }
 

@@ -40,8 +40,8 @@ PathControlParams PathControlParams::fromParams(const ParamReader& r) {
 // ---------------------------------------------------------------------------
 PathController::PathController(std::string name, const PathControlParams& params,
                                std::shared_ptr<const ReferencePath> path, const SimTK::MobilizedBody& chassis,
-                               const SimTK::MobilizedBody::Pin& steer, SimTK::Measure ax, SimTK::Measure ay)
-    : SteeringLaw(std::move(name)), p_(params), path_(std::move(path)), chassis_(chassis), steer_(steer), ax_(ax),
+                               const SteeringActuator& steer, SimTK::Measure ax, SimTK::Measure ay)
+    : SteeringLaw(std::move(name)), p_(params), path_(std::move(path)), chassis_(chassis), steer_(&steer), ax_(ax),
       ay_(ay) {
   p_.validate();
   if (!path_) throw Error("path controller '" + this->name() + "': no path");
@@ -61,7 +61,7 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
   e.v_ahead_G = e.v_G + e.a_G * dT;                           // (7.15)-(7.16)
   e.now = path_->calcErrors(e.p_G, e.v_G);                    // e1, e2 (7.9)-(7.10), (7.19)-(7.21)
   e.ahead = path_->calcErrors(e.p_ahead_G, e.v_ahead_G);      // e3, e4
-  e.steer_rate_rad_s = steer_.getRate(s);
+  e.steer_rate_rad_s = steer_->getRate(s);
   // (7.17) with the artificial damper (7.18).
   e.accel_rad_s2 = -(p_.k1_rad_per_s2_per_m * e.now.position_m + p_.k2_rad_per_s2 * e.now.slope +
                      p_.k3_rad_per_s2_per_m * e.ahead.position_m + p_.k4_rad_per_s2 * e.ahead.slope) -
@@ -134,7 +134,7 @@ const PathController& PathControlPlugin::controller() const {
 }
 
 void PathControlPlugin::DoAddTo(Scene& scene) {
-  auto* steer = scene.findPlugin<SteeringPlugin>(steering_);
+  auto* steer = scene.findPlugin<SteeringActuator>(steering_);
   if (!steer) throw Error("path control plugin '" + name() + "': the scene has no steering plugin '" + steering_ + "'");
   if (!steer->isStateDriven())
     throw Error("path control plugin '" + name() + "': steering plugin '" + steering_ +
@@ -145,7 +145,7 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
     ax = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 0, p_.acceleration_lag_s);
     ay = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 1, p_.acceleration_lag_s);
   }
-  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, steer->getSteerBody(), ax, ay);
+  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, *steer, ax, ay);
   steer->setAccelerationLaw(law_);
   const auto law = law_;
   auto add = [&](const std::string& key, const std::string& unit, auto f) {

@@ -7,49 +7,6 @@ namespace vdyn {
 using SimTK::Vec3;
 
 // ---------------------------------------------------------------------------
-void KrTable::validate(const std::string& where) const {
-  if (rows.empty()) throw Error(where + ": the table has no rows");
-  for (std::size_t i = 0; i < rows.size(); ++i) {
-    const std::string at = where + "[" + std::to_string(i) + "]";
-    requireNonNegative(rows[i].speed_m_s, at + ".speed_m_s");
-    requireFinite(rows[i].c1, at + ".c1");
-    requireFinite(rows[i].c2_per_deg2, at + ".c2_per_deg2");
-    if (i > 0 && !(rows[i].speed_m_s > rows[i - 1].speed_m_s))
-      throw Error(at + ".speed_m_s: speeds must be ascending, got " + formatValue(rows[i].speed_m_s) + " after " +
-                  formatValue(rows[i - 1].speed_m_s));
-  }
-}
-
-KrTable KrTable::fromParams(const ParamReader& r) {
-  const std::string unit = r.string("delta_f_unit");
-  if (unit != "deg") throw Error(r.at("delta_f_unit") + ": must be \"deg\", got \"" + unit + "\"");
-  KrTable t;
-  for (const auto& row : r.array("fit")) {
-    t.rows.push_back({row.number("speed_m_s"), row.number("c1"), row.number("c2_per_deg2")});
-    // The fit's provenance (ch6_steering_ratio writes it): known keys, not used here.
-    row.has("rms_residual");
-    row.has("points");
-  }
-  r.requireAllKeysRead();
-  t.validate(r.at("fit"));
-  return t;
-}
-
-KrTable KrTable::fromFile(const std::string& path) { return fromParams(ParamReader::fromFile(path)); }
-
-KrTable::Row KrTable::calcAt(double U) const {
-  requireFinite(U, "Kr table speed_m_s");
-  assert(!rows.empty());
-  if (U <= rows.front().speed_m_s) return rows.front();
-  if (U >= rows.back().speed_m_s) return rows.back();
-  std::size_t i = 1;
-  while (rows[i].speed_m_s < U) ++i;
-  const Row &lo = rows[i - 1], &hi = rows[i];
-  const double w = (U - lo.speed_m_s) / (hi.speed_m_s - lo.speed_m_s);
-  return {U, lo.c1 + w * (hi.c1 - lo.c1), lo.c2_per_deg2 + w * (hi.c2_per_deg2 - lo.c2_per_deg2)};
-}
-
-// ---------------------------------------------------------------------------
 RearSteerTarget RearSteerStrategy::calcTarget(double U, double df, double dfd, double dfdd) const {
   requireFinite(U, "rear steer speed_m_s");
   requireFinite(df, "rear steer front angle_rad");
@@ -112,10 +69,10 @@ RearSteerParams RearSteerParams::fromParams(const ParamReader& r) {
 
 // ---------------------------------------------------------------------------
 RearSteerLaw::RearSteerLaw(std::string name, std::shared_ptr<const RearSteerStrategy> strategy,
-                           const RearSteerParams& params, const SteeringPlugin& front, const SteeringPlugin& rear,
+                           const RearSteerParams& params, const SteeringActuator& front, const SteeringActuator& rear,
                            const SimTK::MobilizedBody& chassis)
     : SteeringLaw(std::move(name)), strategy_(std::move(strategy)), p_(params), front_(&front),
-      rear_(rear.getSteerBody()), chassis_(chassis) {
+      rear_(&rear), chassis_(chassis) {
   p_.validate();
   if (!strategy_) throw Error("rear steer law '" + this->name() + "': no strategy");
 }
@@ -128,8 +85,8 @@ RearSteerEvaluation RearSteerLaw::calcEvaluation(const SimTK::State& s) const {
   e.front_rate_rad_s = front_->getRate(s);
   e.front_accel_rad_s2 = front_->calcAcceleration(s);
   e.target = strategy_->calcTarget(e.speed_m_s, e.front_angle_rad, e.front_rate_rad_s, e.front_accel_rad_s2);
-  e.rear_angle_rad = rear_.getAngle(s);
-  e.rear_rate_rad_s = rear_.getRate(s);
+  e.rear_angle_rad = rear_->getAngle(s);
+  e.rear_rate_rad_s = rear_->getRate(s);
   // (8.5) / (8.8): the target's acceleration plus the G1, G2 tracking terms.
   e.accel_rad_s2 = e.target.accel_rad_s2 + p_.g1_per_s2 * (e.target.angle_rad - e.rear_angle_rad) +
                    p_.g2_per_s * (e.target.rate_rad_s - e.rear_rate_rad_s);
@@ -156,15 +113,15 @@ const RearSteerLaw& RearSteerPlugin::law() const {
 
 void RearSteerPlugin::DoAddTo(Scene& scene) {
   auto find = [&](const std::string& n) {
-    auto* st = scene.findPlugin<SteeringPlugin>(n);
+    auto* st = scene.findPlugin<SteeringActuator>(n);
     if (!st) throw Error("rear steer plugin '" + name() + "': the scene has no steering plugin '" + n + "'");
     if (!st->isStateDriven())
       throw Error("rear steer plugin '" + name() + "': steering plugin '" + n +
                   "' follows a time command; it must be state-driven");
     return st;
   };
-  SteeringPlugin* rear = find(rear_);
-  const SteeringPlugin* front = find(front_);
+  SteeringActuator* rear = find(rear_);
+  const SteeringActuator* front = find(front_);
   law_ = std::make_shared<RearSteerLaw>(name(), strategy_, p_, *front, *rear, scene.getBody(chassis_));
   rear->setAccelerationLaw(law_);
   const auto law = law_;

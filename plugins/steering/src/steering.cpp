@@ -139,14 +139,6 @@ void SteeringConstraintImpl::addInPositionConstraintForces(
 
 // ---------------------------------------------------------------------------
 // State-driven steering.
-double SteeringLaw::calcAcceleration(const SimTK::State& s) const {
-  const double a = DoCalcAcceleration(s);
-  if (!std::isfinite(a))
-    throw Error("steering law '" + name_ + "': acceleration must be a finite number, got " + formatValue(a) +
-                " at t = " + formatValue(s.getTime()) + " s");
-  return a;
-}
-
 void SteeringStateSpec::validate(const std::string& where) const {
   requireInRange(initial_angle_rad, -1.2, 1.2, where + " initial_angle_rad");
   requirePositive(steer_body_inertia_kg_m2, where + " steer_body_inertia_kg_m2");
@@ -273,7 +265,7 @@ const SteeringCommand& SteeringPlugin::command() const {
   return *command_;
 }
 
-void SteeringPlugin::setAccelerationLaw(std::shared_ptr<const SteeringLaw> law) {
+void SteeringPlugin::DoSetAccelerationLaw(std::shared_ptr<const SteeringLaw> law) {
   if (!stateDriven_)
     throw Error("steering plugin '" + name() + "' follows a time command; a law needs a state-driven plugin");
   if (!law) throw Error("steering plugin '" + name() + "': empty acceleration law");
@@ -283,20 +275,17 @@ void SteeringPlugin::setAccelerationLaw(std::shared_ptr<const SteeringLaw> law) 
   slot_->law = std::move(law);
 }
 
-bool SteeringPlugin::hasAccelerationLaw() const { return slot_->law != nullptr; }
+bool SteeringPlugin::DoHasAccelerationLaw() const { return slot_->law != nullptr; }
 
-double SteeringPlugin::getAngle(const SimTK::State& s) const {
-  assert(stateDriven_);
+double SteeringPlugin::DoGetAngle(const SimTK::State& s) const {
   return steer_.getAngle(s);
 }
 
-double SteeringPlugin::getRate(const SimTK::State& s) const {
-  assert(stateDriven_);
+double SteeringPlugin::DoGetRate(const SimTK::State& s) const {
   return steer_.getRate(s);
 }
 
-double SteeringPlugin::calcAcceleration(const SimTK::State& s) const {
-  assert(stateDriven_ && slot_->law);
+double SteeringPlugin::DoCalcAcceleration(const SimTK::State& s) const {
   return slot_->law->calcAcceleration(s);
 }
 

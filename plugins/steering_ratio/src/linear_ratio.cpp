@@ -1,9 +1,10 @@
 // Linear bicycle (6.1)-(6.9), fit (8.1) and the coefficient table.
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <set>
 
-#include "vdyn/steering_ratio/steering_ratio.h"
+#include "vdyn/steering_ratio/linear_ratio.h"
 
 namespace vdyn {
 
@@ -137,26 +138,52 @@ std::string formatRatioTable(std::vector<RatioFit> fits) {
   return nlohmann::ordered_json{{"delta_f_unit", "deg"}, {"fit", rows}}.dump(2) + "\n";
 }
 
-std::vector<RatioFit> readRatioTable(const std::string& path) {
-  const ParamReader r = ParamReader::fromFile(path);
+// --- coefficient table (8.1) ---------------------------------------------------
+void KrTable::validate(const std::string& where) const {
+  if (rows.empty()) throw Error(where + ": the table has no rows");
+  for (std::size_t i = 0; i < rows.size(); ++i) {
+    const std::string at = where + "[" + std::to_string(i) + "]";
+    requireNonNegative(rows[i].speed_m_s, at + ".speed_m_s");
+    requireFinite(rows[i].c1, at + ".c1");
+    requireFinite(rows[i].c2_per_deg2, at + ".c2_per_deg2");
+    if (i > 0 && !(rows[i].speed_m_s > rows[i - 1].speed_m_s))
+      throw Error(at + ".speed_m_s: speeds must be ascending, got " + formatValue(rows[i].speed_m_s) + " after " +
+                  formatValue(rows[i - 1].speed_m_s));
+  }
+}
+
+KrTable KrTable::fromParams(const ParamReader& r) {
   const std::string unit = r.string("delta_f_unit");
   if (unit != "deg") throw Error(r.at("delta_f_unit") + ": expected \"deg\", got \"" + unit + "\"");
-  std::vector<RatioFit> fits;
-  for (const ParamReader& row : r.array("fit")) {
-    RatioFit f;
+  KrTable t;
+  for (const auto& row : r.array("fit")) {
+    Row f;
     f.speed_m_s = row.number("speed_m_s");
     f.c1 = row.number("c1");
     f.c2_per_deg2 = row.number("c2_per_deg2");
-    f.rms_residual = row.number("rms_residual");
-    f.points = row.integer("points");
-    if (!fits.empty() && !(f.speed_m_s > fits.back().speed_m_s))
-      throw Error(row.at("speed_m_s") + ": speeds must ascend, got " + formatValue(f.speed_m_s) + " after " +
-                  formatValue(fits.back().speed_m_s));
-    fits.push_back(f);
+    f.rms_residual = row.numberOr("rms_residual", 0.0);
+    f.points = row.has("points") ? row.integer("points") : 0;
+    t.rows.push_back(f);
   }
-  if (fits.empty()) throw Error(r.at("fit") + ": no rows");
   r.requireAllKeysRead();
-  return fits;
+  t.validate(r.at("fit"));
+  return t;
 }
+
+KrTable KrTable::fromFile(const std::string& path) { return fromParams(ParamReader::fromFile(path)); }
+
+KrTable::Row KrTable::calcAt(double U) const {
+  requireFinite(U, "Kr table speed_m_s");
+  assert(!rows.empty());
+  if (U <= rows.front().speed_m_s) return rows.front();
+  if (U >= rows.back().speed_m_s) return rows.back();
+  std::size_t i = 1;
+  while (rows[i].speed_m_s < U) ++i;
+  const Row &lo = rows[i - 1], &hi = rows[i];
+  const double w = (U - lo.speed_m_s) / (hi.speed_m_s - lo.speed_m_s);
+  return {U, lo.c1 + w * (hi.c1 - lo.c1), lo.c2_per_deg2 + w * (hi.c2_per_deg2 - lo.c2_per_deg2)};
+}
+
+std::vector<RatioFit> readRatioTable(const std::string& path) { return KrTable::fromFile(path).rows; }
 
 }  // namespace vdyn

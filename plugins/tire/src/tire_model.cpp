@@ -137,7 +137,7 @@ TireForces TireModel::calcForces(const ContactKinematics& k) const {
 }
 
 // --- Gim ---------------------------------------------------------------------
-// Slips (DESIGN.md section 8): braking (|Omega Re| <= |Vx|): S_s = |Vx - Omega Re| / |Vx|;
+// Slips (docs/equations.md "Tire: Gim"): braking (|Omega Re| <= |Vx|): S_s = |Vx - Omega Re| / |Vx|;
 // driving: S_s = |Vx - Omega Re| / |Omega Re|; the lateral slip |Vy| / den uses
 // the same denominator (in driving (1 - S_s) |tan alpha| = |Vy| / |Omega Re|).
 // Denominators are held >= low_speed_threshold_m_s (regularization at rest).

@@ -28,8 +28,17 @@ Json readJsonFile(const std::string& path);
 /// Parses JSON text; `name` names the source in messages (as readJsonFile).
 Json parseJsonText(const std::string& text, const std::string& name);
 
+/// The folders a data-file name is looked up in when it is not an existing
+/// path, in order: each folder of the environment variable VDYN_DATA_PATH
+/// (':'-separated, read at every call), then the installed data folder
+/// <prefix>/share/vdyn/data, found from the location of the vdyn_core library
+/// (so an installed tree works wherever it is moved), or, when that folder
+/// does not exist (a build tree), the source tree's vehicles/data.
+std::vector<std::string> dataSearchPath();
+
 /// Resolves a data-file name: an existing path is used as is, otherwise it is
-/// looked up in the project's data folder (vehicles/data).
+/// looked up along dataSearchPath(); throws Error naming the file and every
+/// folder looked in.
 std::string resolveDataPath(const std::string& name);
 
 /// Typed access to one object of a data file. Every accessor (has, number,

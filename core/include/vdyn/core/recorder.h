@@ -1,6 +1,8 @@
 #pragma once
 // Samples chosen scene outputs at report times. The simulation loop hands it the
-// integrator's interpolated states, so reporting never forces an integrator step.
+// integrator's interpolant (recordInterpolated) or its interpolated states, so
+// reporting never forces an integrator step, copies no State per sample and
+// projects nothing.
 #include <string>
 #include <vector>
 
@@ -19,6 +21,17 @@ class Recorder {
   /// reallocate every cache entry).
   void record(const SimTK::State& state);
 
+  /// Evaluates the outputs at time `t_s` on the cubic Hermite interpolant of
+  /// one integrator step, from (t0_s, y0, ydot0) to the realized end state
+  /// `end` (its Y and YDot; the formula of Simbody's interpolateOrder3, so the
+  /// values are those of the integrator's own interpolated states, less the
+  /// projection). Nothing is copied but the Y vector into one reused
+  /// workspace state (a full State copy only when `end`'s discrete variables
+  /// changed); the interpolated state is realized to the outputs' stage and
+  /// not projected. t0_s < t_s <= end.getTime().
+  void recordInterpolated(double t_s, double t0_s, const SimTK::Vector& y0, const SimTK::Vector& ydot0,
+                          const SimTK::State& end);
+
   const std::vector<std::string>& names() const { return names_; }
   std::size_t size() const { return time_.size(); }
   const std::vector<double>& time() const { return time_; }
@@ -33,8 +46,11 @@ class Recorder {
   std::vector<std::string> names_;
   std::vector<const Output*> outputs_;
   SimTK::Stage stage_ = SimTK::Stage::Time;
+  /// The workspace's discrete part is that of `like` (copies it if not).
+  void syncWorkspace(const SimTK::State& like);
   SimTK::State work_;
   bool haveWork_ = false;
+  SimTK::Array_<SimTK::StageVersion> workVersions_;  ///< of the state work_ was copied from
   std::vector<double> time_;
   std::vector<std::vector<double>> columns_;
 };

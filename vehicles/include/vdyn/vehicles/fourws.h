@@ -1,5 +1,5 @@
 #pragma once
-// The seed's Appendix A four-wheel-steering vehicle (DESIGN.md section 9): the
+// The seed's Appendix A four-wheel-steering vehicle (docs/vehicle_data.md): the
 // chassis on a free (6-dof) mobilizer, four double-wishbone corners (the left
 // ones mirrored from the right in the builder), four wheels on spin joints, the
 // suspension spring-dampers and four tire plugins on the scene's road. Steering
@@ -16,6 +16,7 @@
 #include "vdyn/tire/tire_force.h"
 #include "vdyn/vehicles/double_wishbone.h"
 #include "vdyn/vehicles/quarter_car.h"
+#include "vdyn/vehicles/reduced_wishbone.h"
 
 namespace vdyn {
 
@@ -32,6 +33,11 @@ struct FourWsParams {
   TireParams tire;
   RoadParams road;                       ///< flat by default
   double gravity_m_per_s2 = 9.81;        ///< along -z, m/s^2
+  /// Data-file key "corner_model": "constrained" (default; each loop closed by
+  /// a Constraint::Ball, the reference model) or "reduced" (the loop solved in
+  /// the knuckle's mobilizer, q = [s, delta]; see reduced_wishbone.h). Both
+  /// describe the same mechanism with the same bodies.
+  std::string corner_model = "constrained";
 
   void validate() const;
   /// Reads a vehicle data file in the layout of appendix_a.json.
@@ -51,6 +57,10 @@ class FourWsVehicle {
   /// The tabulated configuration (chassis c.m. at the height where the tires
   /// carry about the weight, level, at the origin heading +x), the four loops
   /// closed by assembly, moving forward at `speed_m_s` with the wheels rolling.
+  /// The reduced model starts in the constrained model's assembled
+  /// configuration (a constrained copy of the vehicle, with the axle steering
+  /// held at its initial angles, is assembled and its positions read), so
+  /// both models start from the same state.
   SimTK::State makeInitialState(double speed_m_s = 0.0, AssemblyReport* report = nullptr) const;
 
   /// Adds a steering plugin that commands both wheels of the front (or rear)
@@ -65,7 +75,19 @@ class FourWsVehicle {
   int degreesOfFreedom(const SimTK::State& s) const;
 
   const SimTK::MobilizedBody::Free& chassis() const { return chassis_; }
-  const DoubleWishboneCorner& corner(int c) const { return corners_.at(c); }
+  /// Constrained model only (throws Error on the reduced one).
+  const DoubleWishboneCorner& corner(int c) const;
+  bool isReduced() const { return reduced_; }
+  /// Reduced model only (throws Error on the constrained one).
+  const ReducedWishboneCorner& reducedCorner(int c) const;
+  /// Suspension coordinate of a corner: the lower arm's pivot angle, rad (both models).
+  double suspensionAngle(const SimTK::State& s, int c) const;
+  /// Reduced model only: a state of this vehicle in the configuration and
+  /// motion of `other` (a vehicle of the same data, either model) in state
+  /// `os`: chassis, lower-arm angles, steering angles of (A.1), wheel spins,
+  /// their rates, time and z variables (same plugins in the same order).
+  /// The arm angles follow from s; the state is projected to the constraints.
+  SimTK::State makeStateLike(const FourWsVehicle& other, const SimTK::State& os) const;
   const TirePlugin& tire(int c) const { return *tires_.at(c); }
   const DoubleWishboneParams& cornerParams(int c) const { return cornerParams_.at(c); }
 
@@ -75,6 +97,17 @@ class FourWsVehicle {
   SimTK::MobilizedBody::Free chassis_;
   std::array<DoubleWishboneParams, 4> cornerParams_;
   std::array<DoubleWishboneCorner, 4> corners_;
+  bool reduced_ = false;
+  std::array<std::unique_ptr<WishboneLoop>, 4> loops_;
+  std::array<ReducedWishboneCorner, 4> reducedCorners_;
+  std::shared_ptr<const PluginRegistry> registry_;  ///< reduced: for the constrained copy
+  struct AxleSteering {
+    std::string name;
+    bool front;
+    std::shared_ptr<const SteeringCommand> command;  ///< null: state-driven
+    double initial_angle_rad;
+  };
+  std::vector<AxleSteering> axleSteering_;
   std::array<const TirePlugin*, 4> tires_{};
 };
 

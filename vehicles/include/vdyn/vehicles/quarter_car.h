@@ -1,5 +1,5 @@
 #pragma once
-// The seed's chapter 4 quarter car (DESIGN.md section 4): the chassis on a
+// The seed's chapter 4 quarter car (docs/equations.md "Quarter car"): the chassis on a
 // vertical slider, the App. A right-front double-wishbone corner with its loop
 // cut at the upper spherical joint, the suspension spring-damper, the wheel and
 // a tire plugin on a road that moves vertically as A sin(2 pi f t).

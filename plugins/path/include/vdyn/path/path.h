@@ -1,6 +1,6 @@
 #pragma once
-// Reference paths of the seed's closed-loop path control (chapter 7; DESIGN.md
-// section 6): the lane change (7.6)-(7.8) and the J-turn, a circle with an exit
+// Reference paths of the seed's closed-loop path control (chapter 7; docs/equations.md
+// "Path control"): the lane change (7.6)-(7.8) and the J-turn, a circle with an exit
 // angle and a tangent line after it (7.19)-(7.24). Ground plane (X, Y), m; the
 // vehicle travels along +X at the start. Behind one interface: for any point of
 // the plane, the reference point the seed's errors refer to, with its tangent

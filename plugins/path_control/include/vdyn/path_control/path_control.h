@@ -1,6 +1,6 @@
 #pragma once
-// The seed's closed-loop path controller (section 7.3, (7.9)-(7.18); DESIGN.md
-// section 6): the front steering acceleration from the position and slope
+// The seed's closed-loop path controller (section 7.3, (7.9)-(7.18); docs/equations.md,
+// "Path control"): the front steering acceleration from the position and slope
 // errors of the chassis centre of mass against a reference path, now (e1, e2)
 // and at the position predicted a time dT ahead (e3, e4), with an artificial
 // damper on the steering rate:
@@ -27,8 +27,8 @@
 
 #include "vdyn/core/registry.h"
 #include "vdyn/core/scene.h"
+#include "vdyn/core/steering_actuator.h"
 #include "vdyn/path/path.h"
-#include "vdyn/steering/steering.h"
 
 namespace vdyn {
 
@@ -73,8 +73,9 @@ class PathController : public SteeringLaw {
  public:
   /// ax_lagged, ay_lagged: the two lagged acceleration measures of the
   /// "lagged" estimate (empty handles otherwise).
+  /// `steer` is the state-driven steering the law drives (owned by the same scene).
   PathController(std::string name, const PathControlParams& params, std::shared_ptr<const ReferencePath> path,
-                 const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody::Pin& steer,
+                 const SimTK::MobilizedBody& chassis, const SteeringActuator& steer,
                  SimTK::Measure ax_lagged, SimTK::Measure ay_lagged);
   PathControlEvaluation calcEvaluation(const SimTK::State& s) const;
   const PathControlParams& params() const { return p_; }
@@ -87,13 +88,13 @@ class PathController : public SteeringLaw {
   PathControlParams p_;
   std::shared_ptr<const ReferencePath> path_;
   SimTK::MobilizedBody chassis_;
-  SimTK::MobilizedBody::Pin steer_;
+  const SteeringActuator* steer_;  // owned by the same scene
   SimTK::Measure ax_, ay_;
   bool lagged_ = false;
 };
 
 /// Controller plugin: sets a PathController as the law of the named
-/// state-driven steering plugin. Outputs <name>.e1_m, .e2, .e3_m, .e4,
+/// state-driven steering (any SteeringActuator). Outputs <name>.e1_m, .e2, .e3_m, .e4,
 /// .lateral_acceleration_m_s2 (the estimated x'' normal to the velocity),
 /// .path_distance_m (signed closest-point distance of the tracked point to
 /// the path, the reported path error).

@@ -1,5 +1,5 @@
 #pragma once
-// Rear-steer strategies of chapter 8 (DESIGN.md sections 5 and 6): the rear
+// Rear-steer strategies of chapter 8 (docs/equations.md, "Rear steer"): the rear
 // steering angle follows a target delta_r* = f(delta_f) set by the steering
 // angle ratio Kr = delta_r / delta_f, and its acceleration is commanded as
 //     delta_r'' = delta_r*'' + G1 (delta_r* - delta_r) + G2 (delta_r*' - delta_r')   (8.5), (8.8)
@@ -24,32 +24,14 @@
 
 #include "vdyn/core/registry.h"
 #include "vdyn/core/scene.h"
-#include "vdyn/steering/steering.h"
-#include "vdyn/steering_ratio/steering_ratio.h"
+#include "vdyn/core/steering_actuator.h"
+#include "vdyn/steering_ratio/linear_ratio.h"
 
 namespace vdyn {
 
-/// The linear bicycle of chapter 6 (6.1)-(6.9), for Kr(U).
-// LinearBicycleParams and the linear law (6.9), calcLinearOptimalRatio(), come
-// from vdyn/steering_ratio/steering_ratio.h (one definition for both issues).
-
-/// Coefficients of (8.1) against speed (Table 8.1). JSON:
-/// {"delta_f_unit": "deg", "fit": [{"speed_m_s": 6.0, "c1": ..., "c2_per_deg2": ...}, ...]}
-/// with speeds ascending; Kr = c1 + c2_per_deg2 * delta_f_deg^2.
-struct KrTable {
-  struct Row {
-    double speed_m_s = 0;
-    double c1 = 0;           ///< Kr at delta_f = 0
-    double c2_per_deg2 = 0;  ///< 1/deg^2
-  };
-  std::vector<Row> rows;
-
-  void validate(const std::string& where) const;
-  static KrTable fromParams(const ParamReader& r);
-  static KrTable fromFile(const std::string& path);
-  /// c1 and c2 at a speed: linear interpolation, clamped at the table's ends.
-  Row calcAt(double speed_m_s) const;
-};
+// LinearBicycleParams, the linear law (6.9) calcLinearOptimalRatio() and the
+// coefficient table KrTable come from vdyn/steering_ratio/linear_ratio.h (one
+// definition, shared with the steering-ratio analysis that writes the table).
 
 /// The rear angle's target and its derivatives (rad, rad/s, rad/s^2) and the
 /// ratio Kr(U, delta_f) = delta_r* / delta_f (its limit at delta_f = 0).
@@ -128,8 +110,10 @@ struct RearSteerEvaluation {
 
 class RearSteerLaw : public SteeringLaw {
  public:
+  /// `front` and `rear`: state-driven steerings of the same scene (the front
+  /// one driven by a law of its own, e.g. a path controller).
   RearSteerLaw(std::string name, std::shared_ptr<const RearSteerStrategy> strategy, const RearSteerParams& params,
-               const SteeringPlugin& front, const SteeringPlugin& rear, const SimTK::MobilizedBody& chassis);
+               const SteeringActuator& front, const SteeringActuator& rear, const SimTK::MobilizedBody& chassis);
   RearSteerEvaluation calcEvaluation(const SimTK::State& s) const;
   const RearSteerStrategy& strategy() const { return *strategy_; }
 
@@ -139,8 +123,8 @@ class RearSteerLaw : public SteeringLaw {
  private:
   std::shared_ptr<const RearSteerStrategy> strategy_;
   RearSteerParams p_;
-  const SteeringPlugin* front_;  // owned by the same scene
-  SimTK::MobilizedBody::Pin rear_;
+  const SteeringActuator* front_;  // owned by the same scene
+  const SteeringActuator* rear_;
   SimTK::MobilizedBody chassis_;
 };
 

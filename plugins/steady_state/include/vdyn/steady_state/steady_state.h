@@ -1,5 +1,5 @@
 #pragma once
-// The seed's general steady-state analysis (chapter 3, DESIGN.md section 3) on a
+// The seed's general steady-state analysis (chapter 3, docs/equations.md "Steady state") on a
 // Simbody scene, its continuation, stability verdict and sensitivity.
 //
 // The state is split into zero, ineffective and effective variables by a

@@ -1,5 +1,5 @@
 #pragma once
-// Steering driven by a command (seed App. A, (A.1)-(A.4); DESIGN.md sections 6, 9).
+// Steering driven by a command (seed App. A, (A.1)-(A.4); docs/equations.md, "Steering").
 //
 // The steering angle delta of a wheel is the angle between the chassis
 // longitudinal axis x_B and the wheel's lateral (spin) axis s_F, measured so
@@ -31,6 +31,7 @@
 
 #include "vdyn/core/registry.h"
 #include "vdyn/core/scene.h"
+#include "vdyn/core/steering_actuator.h"
 
 namespace vdyn {
 
@@ -101,24 +102,8 @@ class StepSequenceCommand : public SteeringCommand {
   std::vector<SmoothStepCommand> steps_;
 };
 
-/// A steering acceleration law: delta'' (rad/s^2, + toward left) as a function of
-/// the state, e.g. a path controller. It may depend on positions, velocities and
-/// z variables (Stage::Velocity and the Time-stage z's), never on accelerations.
-class SteeringLaw {
- public:
-  virtual ~SteeringLaw() = default;
-  /// delta'' on a state realized to Stage::Velocity; throws Error naming the law
-  /// and the time if it is not a finite number.
-  double calcAcceleration(const SimTK::State& s) const;
-  const std::string& name() const { return name_; }
-
- protected:
-  explicit SteeringLaw(std::string name) : name_(std::move(name)) {}
-  virtual double DoCalcAcceleration(const SimTK::State& s) const = 0;
-
- private:
-  std::string name_;
-};
+// SteeringLaw (a controller's delta'') and SteeringActuator (what controllers
+// see of a state-driven steering) are core interfaces: vdyn/core/steering_actuator.h.
 
 /// Options of a state-driven steering plugin.
 struct SteeringStateSpec {
@@ -205,7 +190,9 @@ double steeringAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis,
 /// the law a controller sets with setAccelerationLaw(). Outputs then also
 /// <name>.rate_rad_s (delta'), <name>.accel_rad_s2 (delta'') and
 /// <name>.drift_rad (measured angle - delta); <name>.command_rad is delta.
-class SteeringPlugin : public ConstraintPlugin {
+/// Controllers reach it through SteeringActuator (isStateDriven, getAngle,
+/// getRate, calcAcceleration, setAccelerationLaw).
+class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
  public:
   SteeringPlugin(std::string name, std::string chassisBody, std::vector<std::string> knuckleBodies,
                  std::shared_ptr<const SteeringCommand> command,
@@ -215,22 +202,19 @@ class SteeringPlugin : public ConstraintPlugin {
   /// The time command (throws Error for a state-driven plugin).
   const SteeringCommand& command() const;
 
-  bool isStateDriven() const { return stateDriven_; }
-  /// Sets the law of a state-driven plugin (once, before the scene is
-  /// finalized). Throws Error for a time-commanded plugin or a second law.
-  void setAccelerationLaw(std::shared_ptr<const SteeringLaw> law);
-  bool hasAccelerationLaw() const;
-  /// State-driven only (asserted): delta (rad), delta' (rad/s) and delta''
-  /// (rad/s^2, from the law; needs Stage::Velocity).
-  double getAngle(const SimTK::State& s) const;
-  double getRate(const SimTK::State& s) const;
-  double calcAcceleration(const SimTK::State& s) const;
   /// State-driven only: the steer body (added to the scene as <name>.steer).
   const SimTK::MobilizedBody::Pin& getSteerBody() const;
 
  protected:
   void DoAddTo(Scene& scene) override;
   void DoInitialize(const Scene& scene, SimTK::State& state) const override;
+  // SteeringActuator
+  bool DoIsStateDriven() const override { return stateDriven_; }
+  void DoSetAccelerationLaw(std::shared_ptr<const SteeringLaw> law) override;
+  bool DoHasAccelerationLaw() const override;
+  double DoGetAngle(const SimTK::State& s) const override;
+  double DoGetRate(const SimTK::State& s) const override;
+  double DoCalcAcceleration(const SimTK::State& s) const override;
 
  private:
   struct LawSlot {

@@ -1,8 +1,8 @@
 #pragma once
 // The seed's optimal four-wheel-steering ratio Kr = delta_r / delta_f (chapters
-// 5-6, DESIGN.md section 5) and its polynomial fit (8.1):
-//  - the linear bicycle (6.1)-(6.9): steady yaw rate and side slip for given
-//    U, delta_f and Kr, and the Kr(U) that makes the steady side slip zero;
+// 5-6, docs/equations.md "Steering ratio") and its polynomial fit (8.1):
+//  - the linear bicycle (6.1)-(6.9) and the fit's table: linear_ratio.h (no
+//    solver; the rear-steer controller uses them too);
 //  - the nonlinear optimum (6.12)-(6.15): for a speed and a front angle, the Kr
 //    for which the steady side slip of a full multibody vehicle is zero, by a
 //    secant-Newton iteration on Kr whose slope d beta / d Kr comes from converged
@@ -20,47 +20,9 @@
 #include "vdyn/core/error.h"
 #include "vdyn/core/params.h"
 #include "vdyn/steady_state/steady_state.h"
+#include "vdyn/steering_ratio/linear_ratio.h"
 
 namespace vdyn {
-
-// --- Linear bicycle (6.1)-(6.9) ----------------------------------------------
-
-/// The linear bicycle of section 6.1: planar, constant speed, lateral tire
-/// forces linear in the slip angles (6.1)-(6.2).
-struct LinearBicycleParams {
-  double mass_kg = 1024;                          ///< M, total mass, kg
-  double front_axle_to_com_m = 1.305;             ///< a, c.m. to front axle, m
-  double rear_axle_to_com_m = 0.965;              ///< b, c.m. to rear axle, m
-  double front_cornering_stiffness_N_per_rad = 1.4e5;  ///< C_af, whole front axle, N/rad
-  double rear_cornering_stiffness_N_per_rad = 1.4e5;   ///< C_ar, whole rear axle, N/rad
-
-  double wheelbase_m() const { return front_axle_to_com_m + rear_axle_to_com_m; }  ///< l = a + b, m
-  /// Understeer gradient K = M / l (b / C_af - a / C_ar), s^2/m (rad per m/s^2 per m of wheelbase).
-  double understeerGradient() const;
-  /// Throws Error naming the field unless every value is finite and positive.
-  void validate() const;
-  /// Reads { "mass_kg", "front_axle_to_com_m", "rear_axle_to_com_m",
-  /// "front_cornering_stiffness_N_per_rad", "rear_cornering_stiffness_N_per_rad" }.
-  static LinearBicycleParams fromParams(const ParamReader& r);
-  static LinearBicycleParams fromFile(const std::string& path);
-};
-
-/// Steady yaw rate of the linear bicycle, rad/s (from (6.5)-(6.6) with beta' =
-/// r' = 0): r = U delta_f (1 - Kr) / (l + K U^2).
-double calcLinearSteadyYawRate(const LinearBicycleParams& p, double speed_m_s, double front_rad, double kr);
-
-/// Steady side slip at the c.m., rad (6.7):
-/// beta = delta_f [1 - (1 - Kr)(a + M b U^2 / (C_af l)) / (l + K U^2)].
-double calcLinearSteadySideSlip(const LinearBicycleParams& p, double speed_m_s, double front_rad, double kr);
-
-/// The ratio that makes (6.7) zero (6.8)-(6.9):
-/// Kr(U) = (-b + M a U^2 / (C_ar l)) / (a + M b U^2 / (C_af l)).
-/// Negative (contra phase) below calcLinearZeroRatioSpeed(), positive above.
-double calcLinearOptimalRatio(const LinearBicycleParams& p, double speed_m_s);
-
-/// The speed at which (6.9) is zero (the vehicle acts as 2WS there):
-/// U = sqrt(b C_ar l / (M a)), m/s.
-double calcLinearZeroRatioSpeed(const LinearBicycleParams& p);
 
 // --- Nonlinear optimal ratio (6.12)-(6.15) -----------------------------------
 
@@ -151,29 +113,5 @@ std::vector<OptimalRatioPoint> followOptimalRatio(SteadyStateSolver& solver, con
                                                   const SetSteering& setSteering, const SideSlipOf& sideSlip,
                                                   const OptimalRatioOptions& options = {},
                                                   bool stop_at_first_failure = true);
-
-// --- Fit (8.1) and the coefficient table -------------------------------------
-
-/// Kr(delta_f) = c1 + c2 delta_f^2 at one speed, delta_f in degrees (8.1).
-struct RatioFit {
-  double speed_m_s = 0;
-  double c1 = 0;               ///< Kr at delta_f = 0, dimensionless
-  double c2_per_deg2 = 0;      ///< 1/deg^2
-  double rms_residual = 0;     ///< rms of Kr - fit over the points, dimensionless
-  int points = 0;              ///< points fitted
-  double evaluate(double front_deg) const { return c1 + c2_per_deg2 * front_deg * front_deg; }
-};
-
-/// Least squares of (8.1) through (front_deg[i], kr[i]). Throws Error unless
-/// there are at least two points with distinct |front_deg| and the sizes match.
-RatioFit fitRatio(double speed_m_s, const std::vector<double>& front_deg, const std::vector<double>& kr);
-
-/// The table as JSON text, keys in this order: {"delta_f_unit": "deg", "fit":
-/// [{"speed_m_s", "c1", "c2_per_deg2", "rms_residual", "points"}, ...]}, speeds
-/// ascending, two-space indent. Throws Error on an empty table or a repeated speed.
-std::string formatRatioTable(std::vector<RatioFit> fits);
-/// Reads that table (a file name or path; // comments allowed); throws Error
-/// naming the file and key on a malformed table.
-std::vector<RatioFit> readRatioTable(const std::string& path);
 
 }  // namespace vdyn

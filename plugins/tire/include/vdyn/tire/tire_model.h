@@ -122,8 +122,8 @@ class TireModel {
   TireParams p_;
 };
 
-/// The seed's analytical comprehensive-slip tire (Gim and Nikravesh; DESIGN.md
-/// section 8): adhesion fraction l_n of the patch, adhesion and sliding parts.
+/// The seed's analytical comprehensive-slip tire (Gim and Nikravesh; docs/equations.md
+/// "Tire: Gim"): adhesion fraction l_n of the patch, adhesion and sliding parts.
 class GimTire : public TireModel {
  public:
   explicit GimTire(const TireParams& p) : TireModel(p) {}
@@ -132,7 +132,7 @@ class GimTire : public TireModel {
   void DoCalcTangential(const ContactKinematics& k, TireForces& f) const override;
 };
 
-/// The Fiala tire as published (DESIGN.md section 11).
+/// The Fiala tire as published (docs/equations.md "Tire: Fiala").
 class FialaTire : public TireModel {
  public:
   explicit FialaTire(const TireParams& p) : TireModel(p) {}

@@ -1,4 +1,4 @@
-#include "vdyn/sensitivity/vehicle_designs.h"
+#include "vdyn/vehicles/vehicle_designs.h"
 
 #include "vdyn/speed/speed_hold.h"
 

@@ -1,5 +1,7 @@
 #pragma once
-// Design models of the vehicles: named handles into their parameter structs.
+// Design models of the vehicles (chapter 4 sensitivity, plugins/sensitivity):
+// named handles into their parameter structs. They live with the vehicles, so
+// the sensitivity plugin depends on core only.
 #include <memory>
 #include <string>
 #include <vector>
