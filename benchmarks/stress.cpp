@@ -250,7 +250,7 @@ int main(int argc, char** argv) {
         dat += std::to_string(cols[ck]) + " " + std::to_string(rows[rk]) + " " + std::to_string(code) + "\n";
       }
       writeFileAtomic(out + "/stress.dat", dat);
-      std::string gp = "set terminal pngcairo size 1600,1400 font 'sans,8'\nset output '" + out + "/stress.png'\n"
+      std::string gp = "set terminal pngcairo size 1600,1400 font 'sans,8' noenhanced\nset output '" + out + "/stress.png'\n"
                        "set title 'stress matrix: green completed, orange event, red named failure, black unnamed'\n"
                        "set palette defined (0 'forest-green', 1 'orange', 2 'red', 3 'black')\nset cbrange [0:3]\n"
                        "unset colorbox\nset xtics rotate by 90 font ',7'\nset ytics font ',7'\n";
