@@ -194,7 +194,6 @@ int main(int argc, char** argv) {
       for (double U : speeds) bySpeed.values.push_back({U});
       sweep.addVariations(makeGridVariations({bySpeed}));
     }
-    std::mutex buildMutex;
     auto runSpeed = [&](const SweepDescription&, const Variation& v) {
       {
         const std::size_t i = v.index;
@@ -207,8 +206,8 @@ int main(int argc, char** argv) {
           auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
           const SpeedHoldPlugin* hold = nullptr;
           {
-            // Building goes through the shared plugin registry: one at a time.
-            std::lock_guard<std::mutex> lock(buildMutex);
+            // Nothing shared is written here (vdyn/core/threads.h); the loop
+            // assembly in makeInitialState takes the process-wide Assembler lock.
             car = std::make_unique<FourWsVehicle>(params);
             car->addAxleSteering("front_steer", true, front);
             car->addAxleSteering("rear_steer", false, rear);
