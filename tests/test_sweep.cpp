@@ -141,7 +141,7 @@ TEST(SweepFile, StrictKeysAndNamedErrors) {
   };
   EXPECT_EQ(load(R"({"scene": "s.json", "variation": []})"),
             "my.sweep.json: variation: unknown key (did you mean 'variations'?); known: scene, name, set, "
-            "variations, collect, output");
+            "variations, collect, output, plots");
   EXPECT_EQ(load(R"({"scene": "s.json", "variations": [{"grid": [{"key": "a", "from": 0, "to": 1, "count": -3}]}]})"),
             "my.sweep.json: variations[0].grid[0].count: expected an integer in [1, 100000000], got -3");
   EXPECT_EQ(load(R"({"scene": "s.json", "variations": [{"grid": [{"key": "a", "valuse": [1]}]}]})"),
@@ -261,4 +261,30 @@ TEST(SweepRunner, ResumeSkipsRunsInTheJournal) {
             std::string::npos)
       << err;
   std::filesystem::remove_all(dir);
+}
+
+TEST(SweepFile, SummaryPathsAndPlots) {
+  const Json summary = Json::parse(R"({"a": {"b": [1, {"c": 2.5}]},
+                                       "plugins": [{"name": "front_steer", "x": 3}, {"name": "rear", "x": 4}]})");
+  EXPECT_EQ(*findJsonPath(summary, "a.b[1].c"), 2.5);
+  EXPECT_EQ(*findJsonPath(summary, "a.b.1.c"), 2.5);
+  EXPECT_EQ(*findJsonPath(summary, "plugins.rear.x"), 4);
+  EXPECT_EQ(findJsonPath(summary, "a.b[2]"), nullptr);
+  EXPECT_EQ(findJsonPath(summary, "a.c"), nullptr);
+  EXPECT_EQ(findJsonPath(summary, "plugins.middle.x"), nullptr);
+
+  const char* base = R"({"scene": "s.json", "variations": [{"grid": [{"key": "k", "values": [1, 2]}]}],
+                         "collect": ["y"], "plots": [%s]})";
+  auto load = [&](const std::string& plot) {
+    char text[1024];
+    std::snprintf(text, sizeof text, base, plot.c_str());
+    return SweepDescription::fromJson(Json::parse(text), "p.json:", "");
+  };
+  const SweepDescription d = load(R"({"png": "y.png", "x": "k", "y": "y", "y_scale": 2})");
+  ASSERT_EQ(d.plots.size(), 1u);
+  EXPECT_EQ(d.plots[0].y_scale, 2.0);
+  EXPECT_EQ(errorOf([&] { load(R"({"png": "y.png", "x": "k", "y": "z"})"); }),
+            "p.json: plots[0].y: 'z' is neither a varied key nor a collected path; columns: k, y");
+  EXPECT_EQ(errorOf([&] { load(R"({"png": "out/y.png", "x": "k", "y": "y"})"); }),
+            "p.json: plots[0].png: expected a file name ending in .png (no folder), got \"out/y.png\"");
 }

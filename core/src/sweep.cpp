@@ -288,7 +288,7 @@ SweepDescription SweepDescription::fromFile(const std::string& path) {
 
 SweepDescription SweepDescription::fromJson(const Json& j, const std::string& where, const std::string& baseDir) {
   requireObject(j, where);
-  requireKnownKeys(j, {"scene", "name", "set", "variations", "collect", "output"}, where);
+  requireKnownKeys(j, {"scene", "name", "set", "variations", "collect", "output", "plots"}, where);
   SweepDescription d;
   auto resolve = [&](const std::string& f) {
     if (f.empty() || f[0] == '/' || baseDir.empty()) return f;
@@ -441,6 +441,52 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
     d.addVariations(sets);
   }
   if (d.variations.size() > 100000000) throw Error(wv + ": more than 1e8 variations");
+
+  if (j.contains("plots")) {
+    const std::string wp = at(where, "plots");
+    const Json& plots = requireArray(j["plots"], wp);
+    for (std::size_t i = 0; i < plots.size(); ++i) {
+      const std::string w = atIndex(wp, i);
+      const Json& pj = requireObject(plots[i], w);
+      requireKnownKeys(pj, {"png", "title", "x", "y", "x_scale", "y_scale", "x_label", "y_label", "series", "panels"},
+                       w);
+      auto text = [&](const char* key, bool required) {
+        if (!pj.contains(key)) {
+          if (required) throw Error(at(w, key) + ": missing key");
+          return std::string();
+        }
+        if (!pj[key].is_string() || pj[key].get<std::string>().empty())
+          throw Error(at(w, key) + ": expected a non-empty string, got " + dumpCompact(pj[key]));
+        return pj[key].get<std::string>();
+      };
+      auto column = [&](const char* key, bool required) {
+        const std::string c = text(key, required);
+        if (c.empty()) return c;
+        if (std::find(d.keys.begin(), d.keys.end(), c) == d.keys.end() &&
+            std::find(d.collect.begin(), d.collect.end(), c) == d.collect.end()) {
+          std::string known;
+          for (const auto& k : d.keys) known += (known.empty() ? "" : ", ") + k;
+          for (const auto& k : d.collect) known += (known.empty() ? "" : ", ") + k;
+          throw Error(at(w, key) + ": '" + c + "' is neither a varied key nor a collected path; columns: " + known);
+        }
+        return c;
+      };
+      SweepPlot p;
+      p.png = text("png", true);
+      if (p.png.find('/') != std::string::npos || p.png.size() < 5 || p.png.substr(p.png.size() - 4) != ".png")
+        throw Error(at(w, "png") + ": expected a file name ending in .png (no folder), got \"" + p.png + "\"");
+      p.title = text("title", false);
+      p.x = column("x", true);
+      p.y = column("y", true);
+      p.series = column("series", false);
+      p.panels = column("panels", false);
+      p.x_label = text("x_label", false);
+      p.y_label = text("y_label", false);
+      if (pj.contains("x_scale")) p.x_scale = requireNumber(pj["x_scale"], at(w, "x_scale"));
+      if (pj.contains("y_scale")) p.y_scale = requireNumber(pj["y_scale"], at(w, "y_scale"));
+      d.plots.push_back(p);
+    }
+  }
   return d;
 }
 
@@ -448,24 +494,40 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
 const Json* findJsonPath(const Json& j, const std::string& path) {
   const Json* cur = &j;
   std::size_t i = 0;
+  auto isIndex = [](const std::string& t) {
+    return !t.empty() && t.size() < 10 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
+  };
   while (i < path.size()) {
     if (path[i] == '.') ++i;
-    if (path[i] == '[') {
+    if (i < path.size() && path[i] == '[') {
       const std::size_t close = path.find(']', i);
       if (close == std::string::npos) return nullptr;
-      const std::size_t k = std::stoul(path.substr(i + 1, close - i - 1));
-      if (!cur->is_array() || k >= cur->size()) return nullptr;
-      cur = &(*cur)[k];
+      const std::string t = path.substr(i + 1, close - i - 1);
+      if (!isIndex(t) || !cur->is_array() || std::stoul(t) >= cur->size()) return nullptr;
+      cur = &(*cur)[std::stoul(t)];
       i = close + 1;
       continue;
     }
     const std::size_t end = path.find_first_of(".[", i);
     const std::string name = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
-    if (!cur->is_object()) return nullptr;
-    auto it = cur->find(name);
-    if (it == cur->end()) return nullptr;
-    cur = &*it;
     i = end == std::string::npos ? path.size() : end;
+    if (cur->is_object()) {
+      auto it = cur->find(name);
+      if (it == cur->end()) return nullptr;
+      cur = &*it;
+    } else if (cur->is_array()) {
+      const Json* found = nullptr;
+      if (isIndex(name)) {
+        if (std::stoul(name) < cur->size()) found = &(*cur)[std::stoul(name)];
+      } else {
+        for (const Json& e : *cur)
+          if (e.is_object() && e.contains("name") && e["name"] == name) found = &e;
+      }
+      if (!found) return nullptr;
+      cur = found;
+    } else {
+      return nullptr;
+    }
   }
   return cur;
 }

@@ -86,6 +86,19 @@ class SweepRandom {
   std::uint64_t s_[4];
 };
 
+/// A plot of the results (rendered by `vdyn sweep` with gnuplot from
+/// results.csv): y against x, one line per value of `series`, one panel per
+/// value of `panels`. Columns are varied keys or collected paths.
+struct SweepPlot {
+  std::string png;              ///< file name in the output folder
+  std::string title;
+  std::string x, y;             ///< columns
+  double x_scale = 1, y_scale = 1;  ///< plotted: column value times the scale
+  std::string x_label, y_label; ///< axis labels (default: the column names)
+  std::string series;           ///< column: one line per value ("" = one line)
+  std::string panels;           ///< column: one panel per value ("" = one panel)
+};
+
 struct SweepDescription {
   std::string file;      ///< the sweep file ("" when built in C++); names it in messages
   std::string name;      ///< sweep name (default: the file's stem)
@@ -95,6 +108,7 @@ struct SweepDescription {
   std::vector<Variation> variations;  ///< in output order (index = position)
   std::vector<std::string> collect;   ///< summary paths collected into columns
   std::string output;    ///< output folder from the file ("" if not given)
+  std::vector<SweepPlot> plots;       ///< "plots"
 
   /// Reads a sweep file. Top-level keys (all but scene and variations optional):
   ///   "scene": "file.json"               scene file (relative to the sweep file)
@@ -110,6 +124,9 @@ struct SweepDescription {
   ///                                          "ranges": {"key": [min, max], ...}}}
   ///   "collect": ["summary.path", ...]   quantities from each run's summary
   ///   "output": "folder"                 relative to the sweep file
+  ///   "plots": [{"png": "f.png", "x": column, "y": column, "series": column,
+  ///              "panels": column, "title", "x_label", "y_label", "x_scale",
+  ///              "y_scale"}]               columns: varied keys or collected paths
   /// Unknown keys, wrong types, empty sets and duplicate keys are vdyn::Error
   /// naming the file, the key path and the value.
   static SweepDescription fromFile(const std::string& path);
@@ -124,7 +141,9 @@ struct SweepDescription {
   std::uint64_t fingerprint() const;
 };
 
-/// The value at a dotted path ("runs[3].max_path_error_m") in `j`, or nullptr.
+/// The value at a dotted path in `j`, or nullptr. Array elements by index
+/// ("runs[3].x" or "runs.3.x") or, in arrays of objects, by their "name"
+/// ("plugins.front_steer.x", as scene --set paths name them).
 const Json* findJsonPath(const Json& j, const std::string& path);
 
 /// The result of one variation.
