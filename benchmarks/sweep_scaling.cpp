@@ -96,6 +96,7 @@ struct Measured {
   double load = 0;         ///< 1-min load average at the start (median)
   int workers = 0;
   std::size_t runs = 0, failed = 0;
+  double tail_bound = 0;   ///< threads: sum of run times / longest run (the most any N can give)
   std::string csv;
 };
 
@@ -123,6 +124,9 @@ Measured measure(const Config& c, const std::string& workload, int runs, double 
       wall.push_back(res.wall_s);
       cpu.push_back(res.cpu_s);
       m.workers = res.workers;
+      double sum = 0, longest = 0;
+      for (const SweepRow& row : res.rows) sum += row.wall_s, longest = std::max(longest, row.wall_s);
+      m.tail_bound = longest > 0 ? sum / longest : 0;
     } else {
       char cmd[4096];
       std::snprintf(cmd, sizeof cmd,
@@ -226,7 +230,8 @@ int main(int argc, char** argv) {
     std::vector<Measured> ms;
     for (const Config& c : configs) ms.push_back(measure(c, "ch3", runs, tMin, tMax, repeats, out));
 
-    std::printf("\n  ch3 sweep            workers   wall s  speed-up   CPU s  CPU/wall  runner ms/run  load(1 min)  runs\n");
+    std::printf("\n  ch3 sweep            workers   wall s  speed-up   CPU s  CPU/CPU1  CPU/wall  idle+runner ms/run  "
+                "load(1 min)  runs\n");
     const double t1 = ms[0].wall_s;
     bool identical = true;
     for (std::size_t i = 0; i < ms.size(); ++i) {
@@ -235,8 +240,8 @@ int main(int argc, char** argv) {
       char label[64];
       std::snprintf(label, sizeof label, "%s %d%s", configs[i].label == "mpi" ? "MPI processes" : "threads",
                     configs[i].count, configs[i].label == "mpi" ? "" : "      ");
-      std::printf("  %-20s %7d %8.2f %9.2f %7.2f %9.2f %14.2f %12.2f %5zu%s\n", label, m.workers, m.wall_s,
-                  t1 / m.wall_s, m.cpu_s, m.cpu_s / m.wall_s, m.overhead_ms, m.load, m.runs,
+      std::printf("  %-20s %7d %8.2f %9.2f %7.2f %9.3f %9.2f %19.2f %12.2f %5zu%s\n", label, m.workers, m.wall_s,
+                  t1 / m.wall_s, m.cpu_s, m.cpu_s / ms[0].cpu_s, m.cpu_s / m.wall_s, m.overhead_ms, m.load, m.runs,
                   m.failed ? " (failed runs!)" : "");
       if (configs[i].label == "mpi")
         std::printf("  %-20s          (mpirun incl. start-up: %.2f s)\n", "", m.launch_s);
@@ -246,7 +251,8 @@ int main(int argc, char** argv) {
     // --- runner overhead: the same runners on runs that do nothing ----------------
     std::vector<Config> nullConfigs = {{"threads", 1, 1}, {"threads", 2, 1}};
     if (mpi) nullConfigs.insert(nullConfigs.end(), {{"mpi", 2, 0}, {"mpi", 2, 1}});
-    std::printf("\n  empty runs (%d): runner overhead  wall s   ms/run (wall / runs)\n", nullRuns);
+    std::printf("\n  empty runs (%d): runner overhead  wall s   ms/run (wall / runs; MPI manager-only: one message\n"
+                "  round trip per run, test-and-sleep waits)\n", nullRuns);
     double serialMsPerRun = 0;
     for (const Config& c : nullConfigs) {
       const Measured m = measure(c, "null", nullRuns, 0, 1, repeats, out);
@@ -273,6 +279,8 @@ int main(int argc, char** argv) {
     for (int n : {2, 4, 8, 16, 64}) std::printf(" %8.2f", 1 / (fSpeedup + (1 - fSpeedup) / n));
     std::printf("\n  f=%.1e", fRunner);
     for (int n : {2, 4, 8, 16, 64}) std::printf(" %8.2f", 1 / (fRunner + (1 - fRunner) / n));
+    std::printf("\n  tail bound of this sweep: S <= sum of run times / longest run = %.2f (%d runs, cost ~ t_end)",
+                ms[0].tail_bound, runs);
     std::printf("\n  (the runner's own f bounds what the runner costs; the measured f also holds the machine's\n"
                 "   other load, memory bandwidth shared by the runs and the tail: the last run alone on a core)\n");
     std::printf("  output: %s\n", out.c_str());
