@@ -290,9 +290,12 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
   requireObject(j, where);
   requireKnownKeys(j, {"scene", "name", "set", "variations", "collect", "output", "plots"}, where);
   SweepDescription d;
-  auto resolve = [&](const std::string& f) {
+  // Relative to the sweep file's folder when the file is there; else as
+  // given (the scene loader then looks along the data search path).
+  auto resolve = [&](const std::string& f, bool mustExist) {
     if (f.empty() || f[0] == '/' || baseDir.empty()) return f;
-    return baseDir + "/" + f;
+    const std::string local = baseDir + "/" + f;
+    return !mustExist || std::filesystem::exists(local) ? local : f;
   };
   auto str = [&](const std::string& key) {
     const Json& v = requireKey(j, key, where);
@@ -300,9 +303,9 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
       throw Error(at(where, key) + ": expected a non-empty string, got " + dumpCompact(v));
     return v.get<std::string>();
   };
-  d.scene = resolve(str("scene"));
+  d.scene = resolve(str("scene"), true);
   if (j.contains("name")) d.name = str("name");
-  if (j.contains("output")) d.output = resolve(str("output"));
+  if (j.contains("output")) d.output = resolve(str("output"), false);
   if (j.contains("set")) {
     const std::string w = at(where, "set");
     for (auto it = requireObject(j["set"], w).begin(); it != j["set"].end(); ++it) {

@@ -102,7 +102,7 @@ struct SweepPlot {
 struct SweepDescription {
   std::string file;      ///< the sweep file ("" when built in C++); names it in messages
   std::string name;      ///< sweep name (default: the file's stem)
-  std::string scene;     ///< the scene file, resolved against the sweep file's folder
+  std::string scene;     ///< the scene file: in the sweep file's folder if there, else as given (data path)
   std::vector<SweepSetting> common;   ///< "set": applied to every run before its variation
   std::vector<std::string> keys;      ///< every varied key path, in column order
   std::vector<Variation> variations;  ///< in output order (index = position)
