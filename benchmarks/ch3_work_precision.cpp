@@ -24,20 +24,19 @@ struct Run {
   RunSummary sum;
 };
 
-Run runCh3(const ParamReader& data, const std::string& method, double accuracy, double tEnd) {
-  const study::Ch3Case ch3 = study::Ch3Case::fromData(data);
-  const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
-  const FourWsVehicle& car = *carPtr;
-  const double U0 = ch3.speed_m_s;
-  SimTK::State s = car.makeInitialState(U0);
+Run runCh3(const std::string& sceneFile, const std::string& method, double accuracy, double tEnd) {
+  const study::Ch3Case ch3 = study::Ch3Case::fromScene(sceneFile);
+  const BuiltScene built = ch3.build();
+  const Scene& scene = built.scene();
+  SimTK::State s = built.makeInitialState();
   SimulationSettings sim = ch3.sim;  // the data file's constraint tolerance; method, accuracy and time swept
   sim.t_end_s = tEnd;
   sim.report_interval_s = 0.05;
   sim.integrator.method = method;
   sim.integrator.accuracy = accuracy;
-  Recorder rec(car.getScene(), {"chassis.yaw_rate_rad_s", "chassis.roll_rad"});
+  Recorder rec(scene, {"chassis.yaw_rate_rad_s", "chassis.roll_rad"});
   Run r;
-  r.sum = simulate(car.getScene(), s, sim, &rec);
+  r.sum = simulate(scene, s, sim, &rec);
   r.yaw = rec.column("chassis.yaw_rate_rad_s");
   r.roll = rec.column("chassis.roll_rad");
   return r;
@@ -57,7 +56,7 @@ int main(int argc, char** argv) {
   return study::run("ch3_work_precision", [&] {
     namespace po = study::po;
     po::options_description opts("Options");
-    opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file")(
+    opts.add_options()("data", po::value<std::string>()->default_value("scenes/ch3_transient.json"), "scene file of the manoeuvre")(
         "integrators", po::value<std::string>()->default_value("rk_merson,rk3,rk_feldberg,cpodes"),
         "comma-separated integrator names")(
         "accuracies", po::value<std::string>()->default_value("1e-3,1e-4,1e-5,1e-6,1e-7,1e-8"), "comma-separated accuracies")(
@@ -65,7 +64,7 @@ int main(int argc, char** argv) {
         "t-end-s", po::value<double>()->default_value(20.0), "simulated time, s")("no-plots", "skip the PNG plot");
     const auto vm = study::parse("ch3_work_precision", "4WS chapter 3 transient: run time against error", argc, argv, opts);
     const std::string out = study::outputDir(vm, "benchmarks/ch3_work_precision");
-    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
+    const std::string data = vm["data"].as<std::string>();
     const double tEnd = vm["t-end-s"].as<double>();
     const Run ref = runCh3(data, "rk_merson", vm["reference-accuracy"].as<double>(), tEnd);
     std::printf("reference: rk_merson at %g, %d steps, %.1f s wall; final yaw rate %.9f rad/s\n\n",

@@ -1,5 +1,6 @@
 #include "vdyn/plugins/builtin.h"
 
+#include "vdyn/forces/body_force.h"
 #include "vdyn/path_control/path_control.h"
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/speed/speed_hold.h"
@@ -7,14 +8,19 @@
 #include "vdyn/tire/tire_force.h"
 
 namespace vdyn {
+void registerBuiltinPlugins(PluginRegistry& r) {
+  registerTirePlugins(r);
+  registerBodyForcePlugins(r);
+  registerSteeringPlugins(r);
+  registerSpeedPlugins(r);
+  registerPathControlPlugins(r);
+  registerRearSteerPlugins(r);
+}
+
 PluginRegistry& builtinPlugins() {
   static PluginRegistry registry = [] {
     PluginRegistry r;
-    registerTirePlugins(r);
-    registerSteeringPlugins(r);
-    registerSpeedPlugins(r);
-    registerPathControlPlugins(r);
-    registerRearSteerPlugins(r);
+    registerBuiltinPlugins(r);
     return r;
   }();
   return registry;

@@ -272,6 +272,13 @@ TEST(SweepFile, SummaryPathsAndPlots) {
   EXPECT_EQ(findJsonPath(summary, "a.b[2]"), nullptr);
   EXPECT_EQ(findJsonPath(summary, "a.c"), nullptr);
   EXPECT_EQ(findJsonPath(summary, "plugins.middle.x"), nullptr);
+  // Keys with dots (scene output names), the longest match first.
+  const Json steady = Json::parse(R"({"steady": {"chassis.yaw_rate_rad_s": 0.3, "chassis": {"x": 1}},
+                                      "e": {"a.b": [5, 6]}})");
+  EXPECT_EQ(*findJsonPath(steady, "steady.chassis.yaw_rate_rad_s"), 0.3);
+  EXPECT_EQ(*findJsonPath(steady, "steady.chassis.x"), 1);
+  EXPECT_EQ(*findJsonPath(steady, "e.a.b[1]"), 6);
+  EXPECT_EQ(findJsonPath(steady, "steady.chassis.y"), nullptr);
 
   const char* base = R"({"scene": "s.json", "variations": [{"grid": [{"key": "k", "values": [1, 2]}]}],
                          "collect": ["y"], "plots": [%s]})";

@@ -1,5 +1,7 @@
 #include "vdyn/core/params.h"
 
+#include <algorithm>
+#include <cstdlib>
 #include <fstream>
 #include <sys/stat.h>
 
@@ -15,13 +17,56 @@ Json readJsonFile(const std::string& path) {
   }
 }
 
-std::string resolveDataPath(const std::string& name) {
+std::vector<std::string> dataSearchPath() {
+  std::vector<std::string> path;
+  if (const char* env = std::getenv("VDYN_DATA_PATH")) {
+    std::string item;
+    for (const char* c = env;; ++c) {
+      if (*c == ':' || *c == 0) {
+        if (!item.empty()) path.push_back(item);
+        item.clear();
+        if (*c == 0) break;
+      } else {
+        item += *c;
+      }
+    }
+  }
+  path.push_back(VDYN_DATA_DIR);
+  return path;
+}
+
+static bool fileExists(const std::string& p) {
   struct stat st;
-  if (stat(name.c_str(), &st) == 0) return name;
-  const std::string inData = std::string(VDYN_DATA_DIR) + "/" + name;
-  if (stat(inData.c_str(), &st) == 0) return inData;
+  return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
+}
+
+static std::string joinFolders(const std::vector<std::string>& folders) {
+  std::string s;
+  for (const auto& f : folders) s += (s.empty() ? "" : ", ") + f;
+  return s;
+}
+
+std::string resolveDataPath(const std::string& name) {
+  if (fileExists(name)) return name;
+  if (!name.empty() && name[0] != '/')
+    for (const auto& dir : dataSearchPath())
+      if (fileExists(dir + "/" + name)) return dir + "/" + name;
   throw Error("data file '" + name + "' not found (looked in the working directory and " +
-              VDYN_DATA_DIR + ")");
+              joinFolders(dataSearchPath()) + ")");
+}
+
+std::string resolveDataPath(const std::string& name, const std::string& namingFile) {
+  if (!name.empty() && name[0] == '/') {
+    if (fileExists(name)) return name;
+    throw Error(namingFile + ": data file '" + name + "' not found");
+  }
+  const auto slash = namingFile.find_last_of('/');
+  const std::string here = slash == std::string::npos ? "." : namingFile.substr(0, slash);
+  if (fileExists(here + "/" + name)) return here == "." ? name : here + "/" + name;
+  for (const auto& dir : dataSearchPath())
+    if (fileExists(dir + "/" + name)) return dir + "/" + name;
+  throw Error(namingFile + ": data file '" + name + "' not found (looked in " + here + ", " +
+              joinFolders(dataSearchPath()) + ")");
 }
 
 ParamReader::ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where)
@@ -39,7 +84,7 @@ Json readWithBase(const std::string& resolved, int depth) {
   const std::string name = resolved.substr(resolved.find_last_of('/') + 1);
   if (!j["based_on"].is_string()) throw Error(name + ": based_on: expected a data file name");
   if (depth >= 8) throw Error(name + ": based_on: chain deeper than 8 files (a cycle?)");
-  Json base = readWithBase(resolveDataPath(j["based_on"].get<std::string>()), depth + 1);
+  Json base = readWithBase(resolveDataPath(j["based_on"].get<std::string>(), resolved), depth + 1);
   j.erase("based_on");
   base.merge_patch(j);
   return base;
@@ -63,9 +108,15 @@ std::string ParamReader::at(const std::string& key) const {
   return where_ + "." + key;
 }
 
-bool ParamReader::has(const std::string& key) const { return node_->contains(key); }
+void ParamReader::note(const std::string& key) const { record_->asked.insert({node_, key}); }
+
+bool ParamReader::has(const std::string& key) const {
+  note(key);
+  return node_->contains(key);
+}
 
 const Json& ParamReader::require(const std::string& key) const {
+  note(key);
   auto it = node_->find(key);
   if (it == node_->end()) throw Error(at(key) + ": missing key");
   return *it;
@@ -132,16 +183,96 @@ int ParamReader::integer(const std::string& key) const {
 ParamReader ParamReader::child(const std::string& key) const {
   const Json& v = require(key);
   if (!v.is_object()) throw Error(at(key) + ": expected an object, got " + v.dump());
-  return ParamReader(root_, &v, at(key));
+  ParamReader c(root_, &v, at(key));
+  c.record_ = record_;
+  record_->visited.insert(&v);
+  return c;
 }
 
 std::vector<ParamReader> ParamReader::array(const std::string& key) const {
   const Json& v = require(key);
   if (!v.is_array()) throw Error(at(key) + ": expected an array, got " + v.dump());
   std::vector<ParamReader> out;
-  for (std::size_t i = 0; i < v.size(); ++i)
+  for (std::size_t i = 0; i < v.size(); ++i) {
     out.emplace_back(root_, &v[i], at(key) + "[" + std::to_string(i) + "]");
+    out.back().record_ = record_;
+    record_->visited.insert(&v[i]);
+  }
   return out;
+}
+
+namespace {
+std::size_t editDistance(const std::string& a, const std::string& b) {
+  std::vector<std::size_t> row(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  for (std::size_t i = 1; i <= a.size(); ++i) {
+    std::size_t diag = row[0];
+    row[0] = i;
+    for (std::size_t j = 1; j <= b.size(); ++j) {
+      const std::size_t up = row[j];
+      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      diag = up;
+    }
+  }
+  return row[b.size()];
+}
+}  // namespace
+
+void ParamReader::collectUnread(const Json& node, const std::string& where, std::vector<std::string>& out) const {
+  auto loc = [&](const std::string& key) {
+    return (!where.empty() && where.back() == ':') ? where + " " + key : where + "." + key;
+  };
+  for (auto it = node.begin(); it != node.end(); ++it) {
+    const std::string& key = it.key();
+    if (!key.empty() && key[0] == '_') continue;
+    if (!record_->asked.count({&node, key})) {
+      std::string hint, best;
+      std::size_t bestD = std::string::npos;
+      for (const auto& [n, k] : record_->asked)
+        if (n == &node && k != key) {
+          const std::size_t d = editDistance(key, k);
+          if (d < bestD) bestD = d, best = k;
+        }
+      if (!best.empty() && bestD <= std::max<std::size_t>(2, key.size() / 3)) hint = " (did you mean '" + best + "'?)";
+      out.push_back(loc(key) + ": unknown key" + hint);
+      continue;
+    }
+    const Json& v = it.value();
+    if (v.is_object() && record_->visited.count(&v)) collectUnread(v, loc(key), out);
+    if (v.is_array())
+      for (std::size_t i = 0; i < v.size(); ++i)
+        if (v[i].is_object() && record_->visited.count(&v[i]))
+          collectUnread(v[i], loc(key) + "[" + std::to_string(i) + "]", out);
+  }
+}
+
+std::vector<std::string> ParamReader::unreadKeys() const {
+  std::vector<std::string> out;
+  collectUnread(*node_, where_, out);
+  return out;
+}
+
+void ParamReader::requireAllKeysRead() const {
+  const auto unread = unreadKeys();
+  if (unread.empty()) return;
+  std::string msg;
+  for (const auto& u : unread) msg += (msg.empty() ? "" : "\n") + u;
+  throw Error(msg);
+}
+
+void ParamReader::markAllRead() const {
+  std::function<void(const Json&)> mark = [&](const Json& n) {
+    if (n.is_object()) {
+      record_->visited.insert(&n);
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        record_->asked.insert({&n, it.key()});
+        mark(it.value());
+      }
+    } else if (n.is_array()) {
+      for (const auto& e : n) mark(e);
+    }
+  };
+  mark(*node_);
 }
 
 }  // namespace vdyn

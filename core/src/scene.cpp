@@ -14,6 +14,7 @@ const char* toString(PluginKind kind) {
     case PluginKind::Constraint: return "constraint";
     case PluginKind::Controller: return "controller";
     case PluginKind::Analysis: return "analysis";
+    case PluginKind::Vehicle: return "vehicle";
   }
   return "?";
 }
@@ -32,35 +33,155 @@ void Plugin::addTo(Scene& scene) {
 
 void Plugin::initialize(const Scene& scene, SimTK::State& state) const { DoInitialize(scene, state); }
 
+void Plugin::setAdjustable(SimTK::State& state, const std::string& key, double value) const {
+  const auto keys = adjustables();
+  if (std::find(keys.begin(), keys.end(), key) == keys.end()) {
+    std::string list;
+    for (const auto& k : keys) list += (list.empty() ? "" : ", ") + k;
+    throw Error(std::string(toString(kind_)) + " plugin '" + name_ + "' (" + type_ + ") has no adjustable '" + key +
+                "'; it has: " + (list.empty() ? "(none)" : list));
+  }
+  requireFinite(value, name_ + "." + key);
+  DoSetAdjustable(state, key, value);
+}
+
 // ---------------------------------------------------------------------------
 // PluginRegistry
+void PluginRegistry::requireNew(PluginKind kind, const std::string& type) const {
+  if (type.empty()) throw Error(std::string(toString(kind)) + " type name is empty");
+  if (has(kind, type)) throw Error(std::string(toString(kind)) + " plugin '" + type + "' is already registered");
+}
+
 void PluginRegistry::add(PluginKind kind, const std::string& type, Factory factory) {
+  add(kind, type, std::move(factory), TypeInfo{});
+}
+
+void PluginRegistry::add(PluginKind kind, const std::string& type, Factory factory, TypeInfo info) {
   if (!factory) throw Error("plugin factory for '" + type + "' is empty");
-  if (!factories_.emplace(std::make_pair(kind, type), std::move(factory)).second)
-    throw Error(std::string(toString(kind)) + " plugin '" + type + "' is already registered");
+  if (kind == PluginKind::Vehicle || kind == PluginKind::Analysis)
+    throw Error(std::string("register ") + toString(kind) + " '" + type + "' with add" +
+                (kind == PluginKind::Vehicle ? "Vehicle" : "Analysis"));
+  requireNew(kind, type);
+  factories_.emplace(std::make_pair(kind, type), std::move(factory));
+  infos_[{kind, type}] = std::move(info);
+}
+
+void PluginRegistry::addVehicle(const std::string& type, VehicleFactory factory, TypeInfo info) {
+  if (!factory) throw Error("vehicle builder for '" + type + "' is empty");
+  requireNew(PluginKind::Vehicle, type);
+  vehicles_.emplace(type, std::move(factory));
+  infos_[{PluginKind::Vehicle, type}] = std::move(info);
+}
+
+void PluginRegistry::addAnalysis(const std::string& type, AnalysisFactory factory, TypeInfo info) {
+  if (!factory) throw Error("analysis factory for '" + type + "' is empty");
+  requireNew(PluginKind::Analysis, type);
+  analyses_.emplace(type, std::move(factory));
+  infos_[{PluginKind::Analysis, type}] = std::move(info);
 }
 
 bool PluginRegistry::has(PluginKind kind, const std::string& type) const {
+  if (kind == PluginKind::Vehicle) return vehicles_.count(type) != 0;
+  if (kind == PluginKind::Analysis) return analyses_.count(type) != 0;
   return factories_.count({kind, type}) != 0;
 }
 
 std::vector<std::string> PluginRegistry::known(PluginKind kind) const {
   std::vector<std::string> names;
-  for (const auto& kv : factories_)
-    if (kv.first.first == kind) names.push_back(kv.first.second);
+  if (kind == PluginKind::Vehicle) {
+    for (const auto& kv : vehicles_) names.push_back(kv.first);
+  } else if (kind == PluginKind::Analysis) {
+    for (const auto& kv : analyses_) names.push_back(kv.first);
+  } else {
+    for (const auto& kv : factories_)
+      if (kv.first.first == kind) names.push_back(kv.first.second);
+  }
   return names;  // std::map keeps them sorted
+}
+
+const TypeInfo& PluginRegistry::info(PluginKind kind, const std::string& type) const {
+  static const TypeInfo none;
+  auto it = infos_.find({kind, type});
+  return it == infos_.end() ? none : it->second;
+}
+
+void PluginRegistry::unknown(PluginKind kind, const std::string& type, const std::string& where) const {
+  std::string list;
+  for (const auto& n : known(kind)) list += (list.empty() ? "" : ", ") + n;
+  throw Error(where + ": unknown " + toString(kind) +
+              (kind == PluginKind::Vehicle || kind == PluginKind::Analysis ? " '" : " plugin '") + type +
+              "'; known: " + (list.empty() ? "(none)" : list));
 }
 
 std::unique_ptr<Plugin> PluginRegistry::create(PluginKind kind, const std::string& type,
                                                const PluginSpec& spec, const std::string& where) const {
   auto it = factories_.find({kind, type});
-  if (it == factories_.end()) {
-    std::string list;
-    for (const auto& n : known(kind)) list += (list.empty() ? "" : ", ") + n;
-    throw Error(where + ": unknown " + toString(kind) + " plugin '" + type + "'; known: " +
-                (list.empty() ? "(none)" : list));
-  }
+  if (it == factories_.end()) unknown(kind, type, where);
   return it->second(spec);
+}
+
+std::unique_ptr<Vehicle> PluginRegistry::createVehicle(const std::string& type, const VehicleSpec& spec,
+                                                       const std::string& where) const {
+  auto it = vehicles_.find(type);
+  if (it == vehicles_.end()) unknown(PluginKind::Vehicle, type, where);
+  auto v = it->second(spec);
+  if (!v) throw Error(where + ": vehicle builder '" + type + "' returned nothing");
+  return v;
+}
+
+std::unique_ptr<Analysis> PluginRegistry::createAnalysis(const std::string& type, const ParamReader& settings,
+                                                         const std::string& where) const {
+  auto it = analyses_.find(type);
+  if (it == analyses_.end()) unknown(PluginKind::Analysis, type, where);
+  auto a = it->second(settings);
+  if (!a) throw Error(where + ": analysis factory '" + type + "' returned nothing");
+  return a;
+}
+
+const std::vector<PluginKind>& allKinds() {
+  static const std::vector<PluginKind> k = {PluginKind::Vehicle, PluginKind::ForceElement, PluginKind::Constraint,
+                                            PluginKind::Controller, PluginKind::Analysis};
+  return k;
+}
+
+const char* toKey(PluginKind kind) {
+  switch (kind) {
+    case PluginKind::ForceElement: return "force_element";
+    case PluginKind::Constraint: return "constraint";
+    case PluginKind::Controller: return "controller";
+    case PluginKind::Analysis: return "analysis";
+    case PluginKind::Vehicle: return "vehicle";
+  }
+  return "?";
+}
+
+PluginKind kindFromKey(const std::string& key, const std::string& where) {
+  for (PluginKind k : allKinds())
+    if (key == toKey(k)) return k;
+  throw Error(where + ": unknown kind '" + key + "'; known: vehicle, force_element, constraint, controller, analysis");
+}
+
+// ---------------------------------------------------------------------------
+// Vehicle, Analysis
+std::vector<std::string> Vehicle::getAttachmentNames() const {
+  std::vector<std::string> names;
+  for (const auto& kv : attachments_) names.push_back(kv.first);
+  return names;
+}
+
+const Attachment& Vehicle::getAttachment(const std::string& name) const {
+  auto it = attachments_.find(name);
+  if (it == attachments_.end()) {
+    std::string list;
+    for (const auto& n : getAttachmentNames()) list += (list.empty() ? "" : ", ") + n;
+    throw Error(type_ + " vehicle has no attachment '" + name + "'; known: " + (list.empty() ? "(none)" : list));
+  }
+  return it->second;
+}
+
+SimTK::State Vehicle::makeInitialState(double speed_m_s) const {
+  requireFinite(speed_m_s, type_ + " initial speed_m_s");
+  return DoMakeInitialState(speed_m_s);
 }
 
 // ---------------------------------------------------------------------------

@@ -511,14 +511,27 @@ const Json* findJsonPath(const Json& j, const std::string& path) {
       i = close + 1;
       continue;
     }
-    const std::size_t end = path.find_first_of(".[", i);
-    const std::string name = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
-    i = end == std::string::npos ? path.size() : end;
+    std::size_t end = path.find_first_of(".[", i);
+    std::string name = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
     if (cur->is_object()) {
-      auto it = cur->find(name);
+      // Keys may hold dots themselves (output names: "steady.chassis.yaw_rate_rad_s"
+      // is key "chassis.yaw_rate_rad_s" under "steady"): the longest key that matches wins.
+      auto it = cur->end();
+      for (std::size_t e = path.size();; e = path.rfind('.', e - 1)) {
+        const std::size_t stop = std::min(e, path.find('[', i));
+        if (stop > i && (it = cur->find(path.substr(i, stop - i))) != cur->end()) {
+          end = stop == path.size() ? std::string::npos : stop;
+          break;
+        }
+        if (e == std::string::npos || e <= i) break;
+      }
       if (it == cur->end()) return nullptr;
       cur = &*it;
-    } else if (cur->is_array()) {
+      i = end == std::string::npos ? path.size() : end;
+      continue;
+    }
+    i = end == std::string::npos ? path.size() : end;
+    if (cur->is_array()) {
       const Json* found = nullptr;
       if (isIndex(name)) {
         if (std::stoul(name) < cur->size()) found = &(*cur)[std::stoul(name)];

@@ -10,9 +10,7 @@
 #include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
-#include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
-#include "vdyn/vehicles/fourws.h"
 
 using namespace vdyn;
 
@@ -40,11 +38,12 @@ int main(int argc, char** argv) {
   return study::run("ch3_steady_state", [&] {
     namespace po = study::po;
     po::options_description opts("Options");
-    opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file");
+    opts.add_options()("data", po::value<std::string>()->default_value("scenes/ch3_transient.json"),
+                       "scene file of the manoeuvre (vdyn run takes the same file)");
     study::Ch3Case::addOptions(opts, "simulated time of the transient, s (default 40)");
     const auto vm = study::parse("ch3_steady_state", "chapter 3 steady state against the long transient", argc, argv,
                                  opts);
-    study::Ch3Case ch3 = study::Ch3Case::fromData(ParamReader::fromFile(vm["data"].as<std::string>()), &vm);
+    study::Ch3Case ch3 = study::Ch3Case::fromScene(vm["data"].as<std::string>(), &vm);
     // Long enough to settle (the data file's 20 s is the transient study's).
     if (!vm.count("t-end-s")) ch3.sim.t_end_s = 40.0;
     ch3.sim.report_interval_s = 0;  // final state only
@@ -53,10 +52,9 @@ int main(int argc, char** argv) {
     const SimulationSettings sim = ch3.sim;
     const std::string out = study::outputDir(vm, "ch3_steady_state");
 
-    const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
-    const FourWsVehicle& car = *carPtr;
-    const Scene& sc = car.getScene();
-    const SimTK::State initial = car.makeInitialState(U0);
+    const BuiltScene built = ch3.build();
+    const Scene& sc = built.scene();
+    const SimTK::State initial = built.makeInitialState();
 
     // Steady state from the transient's initial conditions; the steering
     // commands are evaluated after they settled (Ch3Case::settledTime).

@@ -8,8 +8,6 @@
 #include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
-#include "vdyn/speed/speed_hold.h"
-#include "vdyn/vehicles/fourws.h"
 
 using namespace vdyn;
 
@@ -17,32 +15,29 @@ int main(int argc, char** argv) {
   return study::run("ch3_transient", [&] {
     namespace po = study::po;
     po::options_description opts("Options");
-    opts.add_options()("data", po::value<std::string>()->default_value("ch3_transient.json"), "manoeuvre data file")(
+    opts.add_options()("data", po::value<std::string>()->default_value("scenes/ch3_transient.json"),
+                       "scene file of the manoeuvre (vdyn run takes the same file)")(
         "no-plots", "skip the PNG plots");
     study::Ch3Case::addOptions(opts, "simulated time, s (default: the data file's, 20)");
     const auto vm = study::parse("ch3_transient", "chapter 3 transient of the 4WS vehicle (steer step at constant speed)",
                                  argc, argv, opts);
-    const study::Ch3Case ch3 = study::Ch3Case::fromData(ParamReader::fromFile(vm["data"].as<std::string>()), &vm);
+    const study::Ch3Case ch3 = study::Ch3Case::fromScene(vm["data"].as<std::string>(), &vm);
     const double deg = SimTK::Pi / 180;
     const double U0 = ch3.speed_m_s, front = ch3.front_rad, rear = ch3.rear_rad;
     const SimulationSettings sim = ch3.sim;
     const std::string out = study::outputDir(vm, "ch3_transient");
 
-    const std::unique_ptr<FourWsVehicle> carPtr = ch3.buildVehicle();
-    FourWsVehicle& car = *carPtr;
-    AssemblyReport assembly;
-    SimTK::State s = car.makeInitialState(U0, &assembly);
-    const int dof = car.degreesOfFreedom(s);
-
-    const std::vector<std::string> cols = {
-        "chassis.x_m", "chassis.y_m", "chassis.z_m", "chassis.roll_rad", "chassis.pitch_rad", "chassis.yaw_rad",
-        "chassis.roll_rate_rad_s", "chassis.pitch_rate_rad_s", "chassis.yaw_rate_rad_s", "chassis.side_slip_rad",
-        "rf.spin_rad_s", "lf.spin_rad_s", "rr.spin_rad_s", "lr.spin_rad_s", "front_steer.angle_rad",
-        "rear_steer.angle_rad", "front_steer.command_rad", "rear_steer.command_rad"};
-    // (all at Stage::Velocity or lower: sampling never realizes accelerations)
-    Recorder rec(car.getScene(), cols);
-    const RunSummary run = simulate(car.getScene(), s, sim, &rec, study::progress("ch3_transient", sim.t_end_s));
+    // The scene's composition and run, exactly as `vdyn run` makes them
+    // (analyses/runTransient): the scene records the columns below.
+    BuiltScene built = ch3.build();
+    const TransientRun tr = runTransient(built, ch3.transient, study::progress);
     study::endProgress();
+    const Recorder& rec = *tr.recorder;
+    const RunSummary& run = tr.run;
+    const SimTK::State& s = tr.final_state;
+    const int dof = tr.vehicle.at("dof").get<int>();
+    const double totalMass = tr.vehicle.at("total_mass_kg").get<double>();
+    const double assemblyMove = tr.vehicle.at("assembly_max_body_move_m").get<double>();
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
 
@@ -52,7 +47,7 @@ int main(int argc, char** argv) {
       const auto& c = rec.column(std::string(axle) + ".command_rad");
       for (std::size_t i = 0; i < a.size(); ++i) steerError = std::max(steerError, std::abs(a[i] - c[i]));
     }
-    const Scene& sc = car.getScene();
+    const Scene& sc = built.scene();
     auto fin = [&](const std::string& n) { return sc.evalOutput(n, s); };
     const double r = fin("chassis.yaw_rate_rad_s");
     Json summary = {{"yaw_rate_rad_s", r},
@@ -66,7 +61,7 @@ int main(int argc, char** argv) {
                     {"side_slip_rad", fin("chassis.side_slip_rad")},
                     {"speed_hold_force_N", fin("speed_hold.force_N")},
                     {"dof", dof},
-                    {"total_mass_kg", car.totalMass()},
+                    {"total_mass_kg", totalMass},
                     {"max_constraint_error", run.max_constraint_error},
                     {"max_steer_error_rad", steerError},
                     {"sim_time_s", run.sim_time_s},
@@ -75,7 +70,7 @@ int main(int argc, char** argv) {
                     {"steps", run.steps},
                     {"integrator", run.integrator},
                     {"accuracy", run.accuracy},
-                    {"assembly_max_body_move_m", assembly.max_move_m}};
+                    {"assembly_max_body_move_m", assemblyMove}};
     study::writeJson(out + "/summary.json", summary);
     if (!vm.count("no-plots")) {
       study::plot({{out + "/rates.png", "Chassis roll, pitch and yaw rate", "t (s)", "rate (rad/s)",
@@ -100,7 +95,7 @@ int main(int argc, char** argv) {
     std::printf("  wheel spins         RF %.4f LF %.4f RR %.4f LR %.4f rad/s\n", fin("rf.spin_rad_s"),
                 fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s"));
     std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, max |steer - command| %.2e rad, %d steps\n", dof,
-                car.totalMass(), run.max_constraint_error, steerError, run.steps);
+                totalMass, run.max_constraint_error, steerError, run.steps);
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
   });

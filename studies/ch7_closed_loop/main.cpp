@@ -9,10 +9,10 @@
 
 #include "path_study.h"
 #include "study.h"
-#include "vdyn/core/simulation.h"
-#include "vdyn/path_control/path_control.h"
-#include "vdyn/speed/speed_hold.h"
-#include "vdyn/vehicles/bicycle.h"
+#include "vdyn/analyses/analyses.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/path/path.h"
+#include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
 
@@ -22,24 +22,22 @@ struct RunResult {
   Json summary;
 };
 
-RunResult runOne(const BicycleParams& bp, double U0, const ParamReader& m, const SimulationSettings& base,
-                 const std::string& name, const std::string& out) {
+RunResult runOne(const SceneDescription& base, const ParamReader& m, const std::string& name, const std::string& out) {
+  // The run is the scene (scenes/ch7_closed_loop.json: bicycle, state-driven
+  // steering, path controller, speed hold) with this run's path, gains and
+  // duration, composed and integrated as `vdyn run` does.
   const auto path = makeReferencePath(m.child("path"));
-  const PathControlParams gains = PathControlParams::fromParams(m.child("gains"));
-  Bicycle bike(bp);
-  bike.addFrontSteering("front_steer", SteeringStateSpec{});
-  bike.updScene().addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis", path, gains));
-  bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
-  SimTK::State s = bike.makeInitialState(U0);
-  SimulationSettings sim = base;
-  sim.t_end_s = m.number("t_end_s");
-  Recorder rec(bike.getScene(),
-               {"chassis.x_m", "chassis.y_m", "chassis.yaw_rad", "chassis.yaw_rate_rad_s", "chassis.lateral_speed_m_s",
-                "front_steer.angle_rad", "front_steer.command_rad", "front_steer.rate_rad_s",
-                "front_steer.accel_rad_s2", "front_steer.drift_rad", "path_control.e1_m", "path_control.e2",
-                "path_control.e3_m", "path_control.e4", "path_control.path_distance_m"});
-  const RunSummary run = simulate(bike.getScene(), s, sim, &rec, study::progress(name, sim.t_end_s));
+  const SceneDescription scene = base.withOverrides({{"plugins.path_control.path", m.child("path").json()},
+                                                     {"plugins.path_control.gains", m.child("gains").json()},
+                                                     {"analysis.t_end_s", m.number("t_end_s")}});
+  const TransientSettings settings = TransientSettings::fields().read(
+      ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
+  BuiltScene built = scene.build();
+  const TransientRun tr = runTransient(
+      built, settings, [&](const std::string&, double tEnd) { return study::progress(name, tEnd); });
   study::endProgress();
+  const Recorder& rec = *tr.recorder;
+  const RunSummary& run = tr.run;
   RunResult r;
   r.name = name;
   r.csv = out + "/" + name + ".csv";
@@ -78,19 +76,27 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("ch7_closed_loop",
                                  "closed-loop lane change and J-turn of the nonlinear bicycle (7.3)", argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
-    const BicycleParams bp = BicycleParams::fromFile(data.string("bicycle_data"));
     const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
     requirePositive(U0, "--speed-m-s");
+    IntegratorSettings integrator = IntegratorSettings::fromParams(data.child("integrator"));
+    study::applyIntegratorOptions(vm, integrator);
+    integrator.validate();
+    const SceneDescription scene = SceneDescription::fromFile(
+        "scenes/ch7_closed_loop.json", standardRegistry(),
+        {{"vehicle.data", resolveDataPath(data.string("bicycle_data"))},
+         {"vehicle.initial_speed_m_s", U0},
+         {"plugins.speed_hold.speed_m_s", U0},
+         {"analysis.report_interval_s", data.number("report_interval_s")},
+         {"analysis.integrator",
+          {{"method", integrator.method}, {"accuracy", integrator.accuracy},
+           {"constraint_tolerance", integrator.constraint_tolerance}, {"max_step_s", integrator.max_step_s}}}});
     SimulationSettings base;
-    base.report_interval_s = data.number("report_interval_s");
-    base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
-    study::applyIntegratorOptions(vm, base.integrator);
-    base.integrator.validate();
+    base.integrator = integrator;
     const std::string out = study::outputDir(vm, "ch7_closed_loop");
     const auto wall0 = std::chrono::steady_clock::now();
 
     std::vector<RunResult> runs;
-    for (const char* name : {"lane_change", "j_turn"}) runs.push_back(runOne(bp, U0, data.child(name), base, name, out));
+    for (const char* name : {"lane_change", "j_turn"}) runs.push_back(runOne(scene, data.child(name), name, out));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
     Json list = Json::array();

@@ -7,7 +7,9 @@
 #include <cstdio>
 
 #include "study.h"
-#include "vdyn/core/simulation.h"
+#include "vdyn/analyses/analyses.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/bicycle.h"
 
@@ -19,17 +21,20 @@ struct RunResult {
   Json summary;
 };
 
-RunResult runOne(const BicycleParams& bp, double U0, std::shared_ptr<const SteeringCommand> cmd, double tEnd,
-                 const SimulationSettings& base, const std::string& name, const std::string& out) {
-  Bicycle bike(bp);
-  bike.addFrontSteering("front_steer", std::move(cmd));
-  bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U0));
-  SimTK::State s = bike.makeInitialState(U0);
-  SimulationSettings sim = base;
-  sim.t_end_s = tEnd;
-  Recorder rec(bike.getScene(), {"chassis.x_m", "chassis.y_m", "chassis.yaw_rad", "chassis.yaw_rate_rad_s",
-                                 "chassis.roll_rad", "chassis.side_slip_rad", "front_steer.angle_rad"});
-  const RunSummary run = simulate(bike.getScene(), s, sim, &rec);
+RunResult runOne(const SceneDescription& base, const Json& command, double tEnd, const std::string& name,
+                 const std::string& out) {
+  // The run is the scene (scenes/ch7_open_loop.json: bicycle, steering, speed
+  // hold) with this run's steering command and duration, composed and
+  // integrated as `vdyn run` does.
+  const SceneDescription scene =
+      base.withOverrides({{"plugins.front_steer.command", command}, {"analysis.t_end_s", tEnd}});
+  const TransientSettings settings = TransientSettings::fields().read(
+      ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
+  BuiltScene built = scene.build();
+  const double U0 = built.initial_speed_m_s;
+  const TransientRun tr = runTransient(built, settings);
+  const Recorder& rec = *tr.recorder;
+  const RunSummary& run = tr.run;
   RunResult r;
   r.name = name;
   r.csv = out + "/" + name + ".csv";
@@ -69,7 +74,6 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("ch7_open_loop", "open-loop lane changes and circle of the nonlinear bicycle (7.2)",
                                  argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
-    const BicycleParams bp = BicycleParams::fromFile(data.string("bicycle_data"));
     const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
     requirePositive(U0, "--speed-m-s");
     SimulationSettings base;
@@ -77,6 +81,16 @@ int main(int argc, char** argv) {
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
+    const IntegratorSettings& in = base.integrator;
+    const SceneDescription scene = SceneDescription::fromFile(
+        "scenes/ch7_open_loop.json", standardRegistry(),
+        {{"vehicle.data", resolveDataPath(data.string("bicycle_data"))},
+         {"vehicle.initial_speed_m_s", U0},
+         {"plugins.speed_hold.speed_m_s", U0},
+         {"analysis.report_interval_s", base.report_interval_s},
+         {"analysis.integrator",
+          {{"method", in.method}, {"accuracy", in.accuracy}, {"constraint_tolerance", in.constraint_tolerance},
+           {"max_step_s", in.max_step_s}}}});
     const std::string out = study::outputDir(vm, "ch7_open_loop");
     const auto wall0 = std::chrono::steady_clock::now();
 
@@ -86,19 +100,24 @@ int main(int argc, char** argv) {
                  cross = lc.number("crossover_s");
     for (double d : lc.numbers("amplitudes_rad")) {
       // Figure 7.2a: up, hold, across, hold, back.
-      auto cmd = std::make_shared<StepSequenceCommand>(
-          0.0, std::vector<StepSequenceCommand::Step>{{t0, ramp, d},
-                                                       {t0 + ramp + hold, cross, -2 * d},
-                                                       {t0 + ramp + hold + cross + hold, ramp, d}});
+      const Json cmd = {{"type", "steps"},
+                        {"initial_rad", 0.0},
+                        {"steps",
+                         {{{"start_time_s", t0}, {"duration_s", ramp}, {"change_rad", d}},
+                          {{"start_time_s", t0 + ramp + hold}, {"duration_s", cross}, {"change_rad", -2 * d}},
+                          {{"start_time_s", t0 + ramp + hold + cross + hold}, {"duration_s", ramp}, {"change_rad", d}}}}};
       char name[64];
       std::snprintf(name, sizeof name, "lane_change_%gdeg", std::round(d * 180 / SimTK::Pi * 10) / 10);
-      runs.push_back(runOne(bp, U0, cmd, lc.number("t_end_s"), base, name, out));
+      runs.push_back(runOne(scene, cmd, lc.number("t_end_s"), name, out));
     }
     const ParamReader ci = data.child("circle");
-    runs.push_back(runOne(bp, U0,
-                          std::make_shared<SmoothStepCommand>(0.0, ci.number("angle_rad"), ci.number("start_time_s"),
-                                                              ci.number("ramp_s")),
-                          ci.number("t_end_s"), base, "circle", out));
+    runs.push_back(runOne(scene,
+                          {{"type", "smooth_step"},
+                           {"initial_rad", 0.0},
+                           {"final_rad", ci.number("angle_rad")},
+                           {"start_time_s", ci.number("start_time_s")},
+                           {"duration_s", ci.number("ramp_s")}},
+                          ci.number("t_end_s"), "circle", out));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
     Json list = Json::array();

@@ -1,26 +1,28 @@
 #pragma once
 // The seed's chapter 3 manoeuvre (section 3.3), one definition for the
 // programs that run it (ch3_transient, ch3_steady_state,
-// benchmarks/ch3_work_precision): the App. A 4WS vehicle at a constant speed
-// (3.18), front and rear wheels steered by a smooth step (7.4), read from the
-// manoeuvre data file (ch3_transient.json) with command-line overrides.
-// Header-only: include it from a target that links vdyn_vehicles.
+// benchmarks/ch3_work_precision): the scene file scenes/ch3_transient.json
+// (the App. A 4WS vehicle at a constant speed (3.18), front and rear wheels
+// steered by a smooth step (7.4)), composed through the scene loader like
+// `vdyn run` does, with the programs' options applied as scene overrides.
+// Header-only: include it from a target that links vdyn_standard.
 #include <memory>
 #include <string>
 
 #include "study.h"
-#include "vdyn/core/simulation.h"
-#include "vdyn/speed/speed_hold.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/analyses/analyses.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/vehicles/standard_registry.h"
 
 namespace vdyn::study {
 
 struct Ch3Case {
-  std::string vehicle_data;          ///< vehicle data file
+  SceneDescription scene;            ///< the scene file with the options applied
   double speed_m_s = 10;             ///< U0, m/s
   double front_rad = 0, rear_rad = 0;  ///< final steering angles, rad (+ left)
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
-  SimulationSettings sim;            ///< the data file's "simulation"
+  TransientSettings transient;       ///< the scene's "analysis" (a transient)
+  SimulationSettings sim;            ///< transient.simulation()
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
   /// --integrator, --accuracy.
@@ -32,22 +34,41 @@ struct Ch3Case {
     addIntegratorOptions(opts);
   }
 
-  /// The data file's case; options in `vm` (if given) override it.
-  static Ch3Case fromData(const ParamReader& data, const po::variables_map* vm = nullptr) {
+  /// The scene file's case; options in `vm` (if given) override it:
+  /// --speed-m-s sets vehicle.initial_speed_m_s and the speed hold's
+  /// speed_m_s, --front-deg / --rear-deg the steps' final_rad, --t-end-s,
+  /// --integrator and --accuracy the analysis settings.
+  static Ch3Case fromScene(const std::string& sceneFile, const po::variables_map* vm = nullptr) {
     const double deg = SimTK::Pi / 180;
     auto has = [&](const char* k) { return vm && vm->count(k); };
-    Ch3Case c;
-    c.vehicle_data = data.string("vehicle_data");
-    c.speed_m_s = has("speed-m-s") ? (*vm)["speed-m-s"].as<double>() : data.number("speed_m_s");
-    c.front_rad = has("front-deg") ? (*vm)["front-deg"].as<double>() * deg : data.number("front_angle_rad");
-    c.rear_rad = has("rear-deg") ? (*vm)["rear-deg"].as<double>() * deg : data.number("rear_angle_rad");
-    c.steer_start_s = data.number("steer_start_time_s");
-    c.steer_duration_s = data.number("steer_duration_s");
-    const ParamReader simData = data.child("simulation");
-    c.sim.t_end_s = has("t-end-s") ? (*vm)["t-end-s"].as<double>() : simData.number("t_end_s");
-    c.sim.report_interval_s = simData.number("report_interval_s");
-    c.sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
-    if (vm) applyIntegratorOptions(*vm, c.sim.integrator);
+    std::vector<Override> o;
+    if (has("speed-m-s")) {
+      const double U = requirePositive((*vm)["speed-m-s"].as<double>(), "--speed-m-s");
+      o.push_back({"vehicle.initial_speed_m_s", U});
+      o.push_back({"plugins.speed_hold.speed_m_s", U});
+    }
+    if (has("front-deg")) o.push_back({"plugins.front_steer.command.final_rad", (*vm)["front-deg"].as<double>() * deg});
+    if (has("rear-deg")) o.push_back({"plugins.rear_steer.command.final_rad", (*vm)["rear-deg"].as<double>() * deg});
+    if (has("t-end-s")) o.push_back({"analysis.t_end_s", requirePositive((*vm)["t-end-s"].as<double>(), "--t-end-s")});
+    if (has("integrator")) o.push_back({"analysis.integrator.method", (*vm)["integrator"].as<std::string>()});
+    if (has("accuracy")) o.push_back({"analysis.integrator.accuracy", (*vm)["accuracy"].as<double>()});
+    Ch3Case c{SceneDescription::fromFile(sceneFile, standardRegistry(), o)};
+    const Json& j = c.scene.json();
+    const std::string where = c.scene.path();
+    auto plugin = [&](const std::string& name) -> const Json& {
+      for (const auto& p : j.at("plugins"))
+        if (p.value("name", "") == name) return p;
+      throw Error(where + ": the chapter 3 scene needs a plugin named '" + name + "'");
+    };
+    c.speed_m_s = j.at("vehicle").value("initial_speed_m_s", 0.0);
+    const Json& front = plugin("front_steer").at("command");
+    c.front_rad = front.at("final_rad").get<double>();
+    c.rear_rad = plugin("rear_steer").at("command").at("final_rad").get<double>();
+    c.steer_start_s = front.at("start_time_s").get<double>();
+    c.steer_duration_s = front.at("duration_s").get<double>();
+    c.transient = TransientSettings::fields().read(
+        ParamReader::fromJson(j.at("analysis"), where + " analysis"));
+    c.sim = c.transient.simulation();
     requirePositive(c.speed_m_s, "--speed-m-s");
     requirePositive(c.sim.t_end_s, "--t-end-s");
     return c;
@@ -56,16 +77,9 @@ struct Ch3Case {
   /// When every command has settled (the steady state's evaluation time), s.
   double settledTime() const { return steer_start_s + steer_duration_s; }
 
-  /// The vehicle with its steering ("front_steer", "rear_steer") and speed hold ("speed_hold").
-  std::unique_ptr<FourWsVehicle> buildVehicle() const {
-    auto car = std::make_unique<FourWsVehicle>(FourWsParams::fromFile(vehicle_data));
-    car->addAxleSteering("front_steer", true,
-                         std::make_shared<SmoothStepCommand>(0, front_rad, steer_start_s, steer_duration_s));
-    car->addAxleSteering("rear_steer", false,
-                         std::make_shared<SmoothStepCommand>(0, rear_rad, steer_start_s, steer_duration_s));
-    car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", speed_m_s));
-    return car;
-  }
+  /// The scene: the vehicle with its steering ("front_steer", "rear_steer")
+  /// and speed hold ("speed_hold"), built by the scene loader.
+  BuiltScene build() const { return scene.build(); }
 };
 
 }  // namespace vdyn::study

@@ -5,8 +5,9 @@
 #include <iostream>
 
 #include "study.h"
-#include "vdyn/core/simulation.h"
-#include "vdyn/vehicles/quarter_car.h"
+#include "vdyn/analyses/analyses.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
 
@@ -21,31 +22,26 @@ int main(int argc, char** argv) {
     study::addIntegratorOptions(opts);
     const auto vm = study::parse("quarter_car", "chapter 4 quarter car on a sine road, cost psi = int z''^2 dt",
                                  argc, argv, opts);
-    const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
-    const QuarterCarParams params = QuarterCarParams::fromParams(data);
-    SimulationSettings sim;
-    const ParamReader simData = data.child("simulation");
-    sim.t_end_s = simData.number("t_end_s");
-    sim.report_interval_s = simData.number("report_interval_s");
-    sim.integrator = IntegratorSettings::fromParams(simData.child("integrator"));
-    study::applyIntegratorOptions(vm, sim.integrator);
-    if (vm.count("t-end-s")) sim.t_end_s = vm["t-end-s"].as<double>();
-    if (vm.count("report-interval-s")) sim.report_interval_s = vm["report-interval-s"].as<double>();
-    requirePositive(sim.t_end_s, "--t-end-s");
+    // The scene (scenes/quarter_car.json) composed and run as `vdyn run` does;
+    // the options become scene overrides.
+    std::vector<Override> o = {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}};
+    if (vm.count("integrator")) o.push_back({"analysis.integrator.method", vm["integrator"].as<std::string>()});
+    if (vm.count("accuracy")) o.push_back({"analysis.integrator.accuracy", vm["accuracy"].as<double>()});
+    if (vm.count("t-end-s"))
+      o.push_back({"analysis.t_end_s", requirePositive(vm["t-end-s"].as<double>(), "--t-end-s")});
+    if (vm.count("report-interval-s")) o.push_back({"analysis.report_interval_s", vm["report-interval-s"].as<double>()});
+    const SceneDescription scene = SceneDescription::fromFile("scenes/quarter_car.json", standardRegistry(), o);
+    const TransientSettings settings = TransientSettings::fields().read(
+        ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
+    const SimulationSettings sim = settings.simulation();
     const std::string out = study::outputDir(vm, "quarter_car");
 
-    QuarterCar car(params);
-    const IntegralHandle psi = car.updScene().addIntegralOfSquare("chassis.az_m_s2");
-    AssemblyReport assembly;
-    SimTK::State state = car.makeInitialState(true, &assembly);
-
-    const std::vector<std::string> columns = {"chassis.z_m", "chassis.vz_m_s", "chassis.az_m_s2",
-                                              "road.height_m", "suspension.length_m", "wheel.spin_rad_s",
-                                              "tire.Fz_N", "tire.Fy_N", "tire.Fx_N", "tire.deflection_m"};
-    Recorder rec(car.getScene(), columns);
-    const RunSummary run = simulate(car.getScene(), state, sim, &rec, study::progress("quarter_car", sim.t_end_s));
+    BuiltScene built = scene.build();
+    const TransientRun tr = runTransient(built, settings, study::progress);
     study::endProgress();
-    const double psiValue = car.getScene().getIntegral(psi, state);
+    const Recorder& rec = *tr.recorder;
+    const RunSummary& run = tr.run;
+    const double psiValue = tr.integrals.at(0);
 
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
@@ -58,10 +54,10 @@ int main(int argc, char** argv) {
                     {"wall_time_s", run.wall_time_s},
                     {"t_end_s", sim.t_end_s},
                     {"realizations", run.realizations},
-                    {"dof", car.degreesOfFreedom(state)},
-                    {"total_mass_kg", car.totalMass()},
-                    {"assembly_max_body_move_m", assembly.max_move_m},
-                    {"assembly_initial_loop_gap_m", assembly.initial_loop_gap_m}};
+                    {"dof", tr.vehicle.at("dof")},
+                    {"total_mass_kg", tr.vehicle.at("total_mass_kg")},
+                    {"assembly_max_body_move_m", tr.vehicle.at("assembly_max_body_move_m")},
+                    {"assembly_initial_loop_gap_m", tr.vehicle.at("assembly_initial_loop_gap_m")}};
     study::writeJson(out + "/summary.json", summary);
     if (!vm.count("no-plots")) {
       study::plot({{out + "/chassis_acceleration.png", "Quarter car: chassis vertical acceleration", "t (s)",
@@ -76,8 +72,9 @@ int main(int argc, char** argv) {
     std::printf("  max constraint error      %.3g m\n", run.max_constraint_error);
     std::printf("  steps / realizations      %d / %d\n", run.steps, run.realizations);
     std::printf("  wall time                 %.4f s\n", run.wall_time_s);
-    std::printf("  loop gap closed by assembly %.4f m (largest body move %.4f m)\n", assembly.initial_loop_gap_m,
-                assembly.max_move_m);
+    std::printf("  loop gap closed by assembly %.4f m (largest body move %.4f m)\n",
+                tr.vehicle.at("assembly_initial_loop_gap_m").get<double>(),
+                tr.vehicle.at("assembly_max_body_move_m").get<double>());
     std::printf("  output                    %s\n", out.c_str());
   });
 }

@@ -1,5 +1,7 @@
 #include "vdyn/path_control/path_control.h"
 
+#include "vdyn/core/fields.h"
+
 #include <cmath>
 
 namespace vdyn {
@@ -21,17 +23,26 @@ void PathControlParams::validate() const {
                 acceleration_estimate + "\"");
 }
 
+namespace {
+const FieldTable<PathControlParams>& gainFields() {
+  using P = PathControlParams;
+  static const auto t =
+      FieldTable<P>()
+          .number("k1_rad_per_s2_per_m", &P::k1_rad_per_s2_per_m, "rad/s^2/m", "K1 on e1, position error now (7.17)", true)
+          .number("k2_rad_per_s2", &P::k2_rad_per_s2, "rad/s^2", "K2 on e2, slope error now", true)
+          .number("k3_rad_per_s2_per_m", &P::k3_rad_per_s2_per_m, "rad/s^2/m", "K3 on e3, position error at t + dT", true)
+          .number("k4_rad_per_s2", &P::k4_rad_per_s2, "rad/s^2", "K4 on e4, slope error at t + dT", true)
+          .number("k5_per_s", &P::k5_per_s, "1/s", "K5, damper on delta' (7.18)", true)
+          .number("look_ahead_s", &P::look_ahead_s, "s", "dT of the prediction (7.13)-(7.16)", true)
+          .string("acceleration_estimate", &P::acceleration_estimate, "x'' in the prediction: lagged | none")
+          .number("acceleration_lag_s", &P::acceleration_lag_s, "s", "lag of the measured acceleration (lagged)")
+          .vec3("tracked_point_m", &P::tracked_point_m, "m", "chassis point that follows the path, chassis frame");
+  return t;
+}
+}  // namespace
+
 PathControlParams PathControlParams::fromParams(const ParamReader& r) {
-  PathControlParams p;
-  p.k1_rad_per_s2_per_m = r.number("k1_rad_per_s2_per_m");
-  p.k2_rad_per_s2 = r.number("k2_rad_per_s2");
-  p.k3_rad_per_s2_per_m = r.number("k3_rad_per_s2_per_m");
-  p.k4_rad_per_s2 = r.number("k4_rad_per_s2");
-  p.k5_per_s = r.number("k5_per_s");
-  p.look_ahead_s = r.number("look_ahead_s");
-  p.acceleration_estimate = r.stringOr("acceleration_estimate", p.acceleration_estimate);
-  p.acceleration_lag_s = r.numberOr("acceleration_lag_s", p.acceleration_lag_s);
-  p.tracked_point_m = r.vec3Or("tracked_point_m", p.tracked_point_m);
+  PathControlParams p = gainFields().read(r);
   p.validate();
   return p;
 }
@@ -170,11 +181,24 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
 }
 
 void registerPathControlPlugins(PluginRegistry& registry) {
-  registry.add(PluginKind::Controller, "path_control", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-    return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"),
-                                               makeReferencePath(spec.params.child("path")),
-                                               PathControlParams::fromParams(spec.params.child("gains")));
-  });
+  std::vector<FieldInfo> fields = {
+      {"steering", "-", "required", "name of the state-driven steering plugin it drives (bindable)"},
+      {"chassis", "-", "required", "chassis body (bindable: attach chassis)"},
+      {"path", "-", "required",
+       "reference path {type: lane_change (7.6)-(7.8) | j_turn (7.19)-(7.24), ...}"},
+      {"gains", "-", "required", "gains and look-ahead (the keys 'gains: ...' below)"}};
+  for (auto f : gainFields().describe()) {
+    f.key = "gains: " + f.key;
+    fields.push_back(std::move(f));
+  }
+  registry.add(
+      PluginKind::Controller, "path_control",
+      [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+        return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"),
+                                                   makeReferencePath(spec.params.child("path")),
+                                                   PathControlParams::fromParams(spec.params.child("gains")));
+      },
+      {"path-following steering law (7.9)-(7.18) with look-ahead; outputs <name>.e1_m, ...", fields});
 }
 
 }  // namespace vdyn

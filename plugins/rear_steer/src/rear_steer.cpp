@@ -1,5 +1,7 @@
 #include "vdyn/rear_steer/rear_steer.h"
 
+#include "vdyn/core/fields.h"
+
 #include <cmath>
 
 namespace vdyn {
@@ -97,10 +99,18 @@ void RearSteerParams::validate() const {
   requireNonNegative(g2_per_s, "rear steer g2_per_s");
 }
 
+namespace {
+const FieldTable<RearSteerParams>& trackingFields() {
+  static const auto t = FieldTable<RearSteerParams>()
+                            .number("g1_per_s2", &RearSteerParams::g1_per_s2, "1/s^2",
+                                    "G1 on delta_r* - delta_r (8.5)", true)
+                            .number("g2_per_s", &RearSteerParams::g2_per_s, "1/s", "G2 on delta_r*' - delta_r'", true);
+  return t;
+}
+}  // namespace
+
 RearSteerParams RearSteerParams::fromParams(const ParamReader& r) {
-  RearSteerParams p;
-  p.g1_per_s2 = r.number("g1_per_s2");
-  p.g2_per_s = r.number("g2_per_s");
+  RearSteerParams p = trackingFields().read(r);
   p.validate();
   return p;
 }
@@ -174,17 +184,29 @@ void RearSteerPlugin::DoAddTo(Scene& scene) {
 }
 
 void registerRearSteerPlugins(PluginRegistry& registry) {
-  registry.add(PluginKind::Controller, "rear_steer", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-    const ParamReader& r = spec.params;
-    const LinearBicycleParams linear =
-        r.has("linear_bicycle") ? LinearBicycleParams::fromParams(r.child("linear_bicycle")) : LinearBicycleParams{};
-    std::unique_ptr<KrTable> table;
-    if (r.has("kr_table")) table = std::make_unique<KrTable>(KrTable::fromFile(resolveDataPath(r.string("kr_table"))));
-    return std::make_unique<RearSteerPlugin>(spec.name, spec.bound("rear_steering"), spec.bound("front_steering"),
-                                             spec.bound("chassis"),
-                                             makeRearSteerStrategy(r.string("strategy"), linear, table.get()),
-                                             RearSteerParams::fromParams(r));
-  });
+  std::vector<FieldInfo> fields = {
+      {"rear_steering", "-", "required", "state-driven rear steering plugin it drives (bindable)"},
+      {"front_steering", "-", "required", "front steering plugin it follows (bindable)"},
+      {"chassis", "-", "required", "chassis body (bindable)"},
+      {"strategy", "-", "required", "2ws | linear (Kr(U), 6.1-6.9) | nonlinear (Kr = C1 + C2 delta_f^2, 8.1)"},
+      {"linear_bicycle", "-", "defaults", "linear bicycle {mass_kg, front/rear_axle_to_com_m, cornering stiffnesses}"},
+      {"kr_table", "-", "none", "coefficient table file of the nonlinear strategy (kr_table.json)"}};
+  for (auto f : trackingFields().describe()) fields.push_back(std::move(f));
+  registry.add(
+      PluginKind::Controller, "rear_steer",
+      [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+        const ParamReader& r = spec.params;
+        const LinearBicycleParams linear =
+            r.has("linear_bicycle") ? LinearBicycleParams::fromParams(r.child("linear_bicycle")) : LinearBicycleParams{};
+        std::unique_ptr<KrTable> table;
+        if (r.has("kr_table"))
+          table = std::make_unique<KrTable>(KrTable::fromFile(resolveDataPath(r.string("kr_table"))));
+        return std::make_unique<RearSteerPlugin>(spec.name, spec.bound("rear_steering"), spec.bound("front_steering"),
+                                                 spec.bound("chassis"),
+                                                 makeRearSteerStrategy(r.string("strategy"), linear, table.get()),
+                                                 RearSteerParams::fromParams(r));
+      },
+      {"rear-wheel steering law tracking a target delta_r* (8.1)-(8.8)", fields});
 }
 
 }  // namespace vdyn

@@ -1,5 +1,7 @@
 #include "vdyn/speed/speed_hold.h"
 
+#include "vdyn/core/fields.h"
+
 namespace vdyn {
 
 using SimTK::Vec3;
@@ -98,10 +100,31 @@ double SpeedHoldPlugin::calcForce(const SimTK::State& s) const {
   return -constraint_.getMultipliersAsVector(s)[0];
 }
 
+namespace {
+struct SpeedHoldEntry {
+  std::string chassis = "chassis";
+  double speed_m_s = 0;
+};
+const FieldTable<SpeedHoldEntry>& speedHoldFields() {
+  static const auto t = FieldTable<SpeedHoldEntry>()
+                            .string("chassis", &SpeedHoldEntry::chassis, "chassis body (bindable: attach chassis)")
+                            .number("speed_m_s", &SpeedHoldEntry::speed_m_s, "m/s",
+                                    "forward speed U0 held (3.18), > 0", /*required=*/true);
+  return t;
+}
+}  // namespace
+
 void registerSpeedPlugins(PluginRegistry& registry) {
-  registry.add(PluginKind::Constraint, "speed_hold", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-    return std::make_unique<SpeedHoldPlugin>(spec.name, spec.bound("chassis"), spec.params.number("speed_m_s"));
-  });
+  registry.add(
+      PluginKind::Constraint, "speed_hold",
+      [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+        SpeedHoldEntry e = speedHoldFields().read(spec.params);
+        if (spec.bindings.count("chassis")) e.chassis = spec.bindings.at("chassis");
+        requirePositive(e.speed_m_s, spec.params.at("speed_m_s"));
+        return std::make_unique<SpeedHoldPlugin>(spec.name, e.chassis, e.speed_m_s);
+      },
+      {"constant forward speed v_xi^2 + v_eta^2 = U0^2 (3.18), nonholonomic; output <name>.force_N (propulsive)",
+       speedHoldFields().describe()});
 }
 
 }  // namespace vdyn

@@ -1,5 +1,9 @@
 #include "vdyn/steering/steering.h"
 
+#include <sstream>
+
+#include "vdyn/core/fields.h"
+
 #include <cmath>
 #include <functional>
 
@@ -269,6 +273,17 @@ const SteeringCommand& SteeringPlugin::command() const {
   return *command_;
 }
 
+std::vector<std::string> SteeringPlugin::DoGetAdjustables() const {
+  if (dynamic_cast<const HoldCommand*>(command_.get())) return {"angle_rad"};
+  return {};
+}
+
+void SteeringPlugin::DoSetAdjustable(SimTK::State& state, const std::string&, double value) const {
+  // The command is a model parameter shared with whoever made it (non-const there).
+  const_cast<HoldCommand&>(dynamic_cast<const HoldCommand&>(*command_)).setAngle(value);
+  state.invalidateAllCacheAtOrAbove(SimTK::Stage::Position);
+}
+
 void SteeringPlugin::setAccelerationLaw(std::shared_ptr<const SteeringLaw> law) {
   if (!stateDriven_)
     throw Error("steering plugin '" + name() + "' follows a time command; a law needs a state-driven plugin");
@@ -370,33 +385,83 @@ std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene) {
   return bodies;
 }
 
-void registerSteeringPlugins(PluginRegistry& registry) {
-  registry.add(PluginKind::Constraint, "steering", [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-    std::vector<std::string> knuckles;
-    if (spec.bindings.count("knuckles")) {
-      std::string list = spec.bindings.at("knuckles"), item;
-      for (std::size_t pos = 0; pos <= list.size(); ++pos) {
-        if (pos == list.size() || list[pos] == ',') {
-          if (!item.empty()) knuckles.push_back(item);
-          item.clear();
-        } else {
-          item += list[pos];
-        }
-      }
+namespace {
+/// The keys of a "steering" plugin entry (one table: read, documented by `vdyn list`).
+struct SteeringEntry {
+  std::string chassis = "chassis";
+  std::vector<std::string> knuckles;
+  Vec3 spin_axis{0, 1, 0};
+  std::shared_ptr<const SteeringCommand> command;
+  bool state_driven = false;
+  double initial_rad = 0;
+};
+
+const FieldTable<SteeringEntry>& steeringFields() {
+  static const auto t =
+      FieldTable<SteeringEntry>()
+          .string("chassis", &SteeringEntry::chassis, "chassis body (bindable)")
+          .strings("knuckles", &SteeringEntry::knuckles,
+                   "knuckle bodies steered together, e.g. [\"rf.knuckle\", \"lf.knuckle\"] (bindable: attach an axle)")
+          .vec3("spin_axis", &SteeringEntry::spin_axis, "-", "wheel spin axis in the knuckle frame (bindable)")
+          .custom("command", "-", "required",
+                  "{type: hold (angle_rad) | smooth_step (initial_rad, final_rad, start_time_s, duration_s; 7.4) | "
+                  "steps (initial_rad, steps: [{start_time_s, duration_s, change_rad}]) | state (initial_rad: a "
+                  "controller sets delta'')}; rad, + left",
+                  [](const ParamReader& r, SteeringEntry& e) {
+                    const ParamReader c = r.child("command");
+                    if (c.stringOr("type", "") == "state") {
+                      e.state_driven = true;
+                      e.initial_rad = c.numberOr("initial_rad", 0.0);
+                    } else {
+                      e.command = makeSteeringCommand(c);
+                    }
+                  });
+  return t;
+}
+
+Vec3 parseAxis(const std::string& text, const std::string& where) {
+  std::istringstream in(text);
+  Vec3 a;
+  if (!(in >> a[0] >> a[1] >> a[2])) throw Error(where + ": spin_axis binding '" + text + "': expected 3 numbers");
+  return a;
+}
+
+std::vector<std::string> splitList(const std::string& list) {
+  std::vector<std::string> out;
+  std::string item;
+  for (std::size_t pos = 0; pos <= list.size(); ++pos) {
+    if (pos == list.size() || list[pos] == ',') {
+      if (!item.empty()) out.push_back(item);
+      item.clear();
     } else {
-      const Json& j = spec.params.json().at("knuckles");
-      for (const auto& k : j) knuckles.push_back(k.get<std::string>());
+      item += list[pos];
     }
-    const SimTK::UnitVec3 spin(spec.params.vec3Or("spin_axis", Vec3(0, 1, 0)));
-    const ParamReader command = spec.params.child("command");
-    if (command.stringOr("type", "") == "state") {
-      SteeringStateSpec st;
-      st.initial_angle_rad = command.numberOr("initial_rad", 0.0);
-      return std::make_unique<SteeringPlugin>(spec.name, spec.bound("chassis"), knuckles, st, spin);
-    }
-    return std::make_unique<SteeringPlugin>(spec.name, spec.bound("chassis"), knuckles, makeSteeringCommand(command),
-                                            spin);
-  });
+  }
+  return out;
+}
+}  // namespace
+
+void registerSteeringPlugins(PluginRegistry& registry) {
+  registry.add(
+      PluginKind::Constraint, "steering",
+      [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+        SteeringEntry e;
+        steeringFields().read(spec.params, e);
+        if (spec.bindings.count("chassis")) e.chassis = spec.bindings.at("chassis");
+        if (spec.bindings.count("knuckles")) e.knuckles = splitList(spec.bindings.at("knuckles"));
+        if (spec.bindings.count("spin_axis")) e.spin_axis = parseAxis(spec.bindings.at("spin_axis"), spec.params.where());
+        if (e.knuckles.empty()) throw Error(spec.params.at("knuckles") + ": no knuckles (list them or attach an axle)");
+        const SimTK::UnitVec3 spin(e.spin_axis);
+        if (e.state_driven) {
+          SteeringStateSpec st;
+          st.initial_angle_rad = e.initial_rad;
+          return std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, st, spin);
+        }
+        return std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, e.command, spin);
+      },
+      {"steering angle of knuckles (A.1)-(A.4) held on a time command (holonomic constraint) or state-driven "
+       "by a controller; outputs <name>.angle_rad, <name>.command_rad",
+       steeringFields().describe()});
 }
 
 }  // namespace vdyn

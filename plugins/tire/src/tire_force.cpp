@@ -206,17 +206,36 @@ void TirePlugin::DoAddTo(Scene& scene) {
 }
 
 void registerTirePlugins(PluginRegistry& registry) {
-  for (const char* type : {"gim", "fiala", "linear"}) {
-    registry.add(PluginKind::ForceElement, type, [type](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-      const TireParams p = spec.params.has("params") ? TireParams::fromParams(spec.params.child("params"))
-                                                     : TireParams{};
-      auto plugin = std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"),
-                                          makeTireModel(type, p),
-                                          SimTK::UnitVec3(spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0))),
-                                          "road", spec.params.vec3Or("centre_m", SimTK::Vec3(0)));
-      if (spec.params.has("slip_centre_m")) plugin->setSlipCentre(spec.params.vec3("slip_centre_m"));
-      return plugin;
-    });
+  static const char* summaries[3][2] = {
+      {"gim", "the seed's analytical comprehensive-slip tire (Gim and Nikravesh) on a wheel body"},
+      {"fiala", "the Fiala tire as published, on a wheel body"},
+      {"linear", "linear tire Fx = C_s kappa, Fy = -C_a alpha (no saturation), on a wheel body"}};
+  for (const auto& [type, summary] : summaries) {
+    std::vector<FieldInfo> fields = {
+        {"wheel", "-", "required", "wheel body (bindable: attach a corner)"},
+        {"spin_axis", "-", "[0,1,0]", "spin axis in the wheel frame"},
+        {"centre_m", "m", "[0,0,0]", "tire centre on the wheel's spin axis, wheel frame"},
+        {"slip_centre_m", "m", "centre_m", "where slip velocities are taken, wheel frame"},
+        {"params", "-", "{}", "tire parameters (the keys 'params: ...' below)"}};
+    for (auto f : TireParams::describe()) {
+      f.key = "params: " + f.key;
+      fields.push_back(std::move(f));
+    }
+    const std::string t = type;
+    registry.add(
+        PluginKind::ForceElement, t,
+        [t](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+          const TireParams p = spec.params.has("params") ? TireParams::fromParams(spec.params.child("params"))
+                                                         : TireParams{};
+          SimTK::Vec3 axis = spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0));
+          auto plugin = std::make_unique<TirePlugin>(t, spec.name, spec.bound("wheel"), makeTireModel(t, p),
+                                                     SimTK::UnitVec3(axis), "road",
+                                                     spec.params.vec3Or("centre_m", SimTK::Vec3(0)));
+          if (spec.params.has("slip_centre_m")) plugin->setSlipCentre(spec.params.vec3("slip_centre_m"));
+          return plugin;
+        },
+        TypeInfo{std::string(summary) + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad",
+                 fields});
   }
 }
 

@@ -39,30 +39,41 @@ void TireParams::validate(const std::string& w) const {
 
 const std::vector<TireParams::Field>& TireParams::fields() {
   static const std::vector<Field> f = {
-      {"unloaded_radius_m", &TireParams::unloaded_radius_m},
-      {"carcass_radius_m", &TireParams::carcass_radius_m},
-      {"radial_stiffness_N_per_m", &TireParams::radial_stiffness_N_per_m},
-      {"radial_damping_N_s_per_m", &TireParams::radial_damping_N_s_per_m},
-      {"longitudinal_stiffness_N", &TireParams::longitudinal_stiffness_N},
-      {"cornering_stiffness_N_per_rad", &TireParams::cornering_stiffness_N_per_rad},
-      {"camber_stiffness_N_per_rad", &TireParams::camber_stiffness_N_per_rad},
-      {"mu_max", &TireParams::mu_max},
-      {"mu_min", &TireParams::mu_min},
-      {"rolling_resistance_coefficient", &TireParams::rolling_resistance_coefficient},
-      {"low_speed_threshold_m_s", &TireParams::low_speed_threshold_m_s},
-      {"rolling_radius_deflection_factor", &TireParams::rolling_radius_deflection_factor},
-      {"relaxation_length_longitudinal_m", &TireParams::relaxation_length_longitudinal_m},
-      {"relaxation_length_lateral_m", &TireParams::relaxation_length_lateral_m},
+      {"unloaded_radius_m", &TireParams::unloaded_radius_m, "m", "R1, torus outer radius (Table A.4)"},
+      {"carcass_radius_m", &TireParams::carcass_radius_m, "m", "R2, torus tube radius (0 = thin disc)"},
+      {"radial_stiffness_N_per_m", &TireParams::radial_stiffness_N_per_m, "N/m", "Kz, radial stiffness (Table A.4)"},
+      {"radial_damping_N_s_per_m", &TireParams::radial_damping_N_s_per_m, "N s/m", "Cz, radial damping (not in the seed)"},
+      {"longitudinal_stiffness_N", &TireParams::longitudinal_stiffness_N, "N", "C_s, per unit slip ratio (Table A.4)"},
+      {"cornering_stiffness_N_per_rad", &TireParams::cornering_stiffness_N_per_rad, "N/rad", "C_a (Table A.4)"},
+      {"camber_stiffness_N_per_rad", &TireParams::camber_stiffness_N_per_rad, "N/rad", "C_g, camber thrust at small slip"},
+      {"mu_max", &TireParams::mu_max, "", "friction coefficient at zero comprehensive slip"},
+      {"mu_min", &TireParams::mu_min, "", "friction coefficient at full sliding"},
+      {"rolling_resistance_coefficient", &TireParams::rolling_resistance_coefficient, "",
+       "My = -c Fz Re against the spin"},
+      {"low_speed_threshold_m_s", &TireParams::low_speed_threshold_m_s, "m/s",
+       "slip denominators held at this speed near standstill"},
+      {"rolling_radius_deflection_factor", &TireParams::rolling_radius_deflection_factor, "",
+       "f in Re = R1 - f delta"},
+      {"relaxation_length_longitudinal_m", &TireParams::relaxation_length_longitudinal_m, "m",
+       "sigma_x (0 = steady slip, the seed's)"},
+      {"relaxation_length_lateral_m", &TireParams::relaxation_length_lateral_m, "m", "sigma_y (0 = steady slip)"},
   };
   return f;
 }
 
+std::vector<FieldInfo> TireParams::describe() {
+  const TireParams def;
+  std::vector<FieldInfo> out;
+  for (const auto& f : fields()) out.push_back({f.key, f.unit, Json(def.*f.member).dump(), f.meaning});
+  return out;
+}
+
 TireParams TireParams::fromParams(const ParamReader& r) {
   TireParams p;
-  for (const auto& [key, member] : fields()) p.*member = r.numberOr(key, p.*member);
+  for (const auto& f : fields()) p.*f.member = r.numberOr(f.key, p.*f.member);
   for (auto it = r.json().begin(); it != r.json().end(); ++it) {
     bool known = false;
-    for (const auto& f : fields()) known |= (it.key() == f.first);
+    for (const auto& f : fields()) known |= (it.key() == f.key);
     if (!known && it.key().rfind("_", 0) != 0) throw Error(r.at(it.key()) + ": unknown tire parameter");
   }
   p.validate(r.where());
@@ -71,7 +82,7 @@ TireParams TireParams::fromParams(const ParamReader& r) {
 
 Json TireParams::toJson() const {
   Json j = Json::object();
-  for (const auto& [key, member] : fields()) j[key] = this->*member;
+  for (const auto& f : fields()) j[f.key] = this->*f.member;
   return j;
 }
 

@@ -4,6 +4,7 @@
 // methods are non-virtual: they validate, then call the protected Do...() hooks.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <Simbody.h>
 
@@ -13,7 +14,10 @@ namespace vdyn {
 
 class Scene;
 
-enum class PluginKind { ForceElement, Constraint, Controller, Analysis };
+/// The kinds of the registry. Plugins (added to a scene) are force elements,
+/// constraints and controllers; analyses (analysis.h) and vehicles (vehicle.h)
+/// are registered the same way but are not Plugins.
+enum class PluginKind { ForceElement, Constraint, Controller, Analysis, Vehicle };
 /// "force element", "constraint", ... as used in messages.
 const char* toString(PluginKind kind);
 
@@ -36,10 +40,21 @@ class Plugin {
   /// plugin's own state, if any).
   void initialize(const Scene& scene, SimTK::State& state) const;
 
+  /// Scalars the plugin lets analyses change without rebuilding the scene (a
+  /// continuation's driving condition), e.g. speed hold "speed_m_s", a held
+  /// steering command "angle_rad".
+  std::vector<std::string> adjustables() const { return DoGetAdjustables(); }
+  /// Sets one on `state` (or on the model, for a parameter that is not state:
+  /// then re-realize states from Stage::Position). Throws Error naming the
+  /// plugin and listing its adjustables if `key` is not one of them.
+  void setAdjustable(SimTK::State& state, const std::string& key, double value) const;
+
  protected:
   Plugin(PluginKind kind, std::string type, std::string name);
   virtual void DoAddTo(Scene& scene) = 0;
   virtual void DoInitialize(const Scene&, SimTK::State&) const {}
+  virtual std::vector<std::string> DoGetAdjustables() const { return {}; }
+  virtual void DoSetAdjustable(SimTK::State&, const std::string&, double) const {}
 
  private:
   PluginKind kind_;
@@ -69,11 +84,6 @@ class ControllerPlugin : public Plugin {
       : Plugin(PluginKind::Controller, std::move(type), std::move(name)) {}
 };
 
-/// An analysis run on a scene (steady state, sensitivity).
-class AnalysisPlugin : public Plugin {
- protected:
-  AnalysisPlugin(std::string type, std::string name)
-      : Plugin(PluginKind::Analysis, std::move(type), std::move(name)) {}
-};
+// Analyses are not plugins of a scene: see vdyn::Analysis (analysis.h).
 
 }  // namespace vdyn

@@ -62,6 +62,9 @@ class SpeedHoldPlugin : public ConstraintPlugin {
 
  protected:
   void DoAddTo(Scene& scene) override;
+  /// "speed_m_s" (setSpeed).
+  std::vector<std::string> DoGetAdjustables() const override { return {"speed_m_s"}; }
+  void DoSetAdjustable(SimTK::State& state, const std::string&, double value) const override { setSpeed(state, value); }
 
  private:
   std::string chassis_;

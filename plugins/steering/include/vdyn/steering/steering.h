@@ -231,6 +231,9 @@ class SteeringPlugin : public ConstraintPlugin {
  protected:
   void DoAddTo(Scene& scene) override;
   void DoInitialize(const Scene& scene, SimTK::State& state) const override;
+  /// "angle_rad" for a plugin on a HoldCommand (HoldCommand::setAngle).
+  std::vector<std::string> DoGetAdjustables() const override;
+  void DoSetAdjustable(SimTK::State& state, const std::string& key, double value) const override;
 
  private:
   struct LawSlot {

@@ -11,6 +11,7 @@
 #include <utility>
 #include <vector>
 
+#include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 
 namespace vdyn {
@@ -52,9 +53,16 @@ struct TireParams {
   static TireParams fromParams(const ParamReader& r);
   /// The same keys, for data files and for plugin factories.
   Json toJson() const;
-  /// The one list of (key, member) pairs that fromParams and toJson use.
-  using Field = std::pair<const char*, double TireParams::*>;
+  /// The one list of keys that fromParams, toJson and describe use.
+  struct Field {
+    const char* key;
+    double TireParams::*member;
+    const char* unit;     ///< SI unit ("" = dimensionless)
+    const char* meaning;  ///< one line
+  };
   static const std::vector<Field>& fields();
+  /// The keys with units, defaults and meanings (`vdyn list`).
+  static std::vector<FieldInfo> describe();
 };
 
 /// Kinematics of the contact, computed by the force element (or given by a test).

@@ -1,0 +1,76 @@
+#pragma once
+// The one idea of an analysis: a scene description and settings in; a summary
+// (JSON), tables (CSV) and files out. Analyses are registered by name
+// (transient, static_equilibrium, steady_state, continuation, stability,
+// sensitivity, optimal_ratio, ...) and built from the scene file's "analysis"
+// object, whose settings the factory reads (and so validates) at load time.
+// Following the Drake convention, run() is public and non-virtual: it checks
+// the context and calls the protected DoRun().
+#include <functional>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <SimTKcommon.h>
+
+#include "vdyn/core/params.h"
+
+namespace vdyn {
+
+class SceneDescription;
+struct BuiltScene;
+
+/// A table: named columns of numbers (written as CSV with a header row).
+struct Table {
+  std::vector<std::string> columns;
+  std::vector<std::vector<double>> rows;
+  void writeCsv(const std::string& path) const;
+};
+
+/// What an analysis hands back.
+struct AnalysisResult {
+  Json summary = Json::object();                        ///< becomes summary.json
+  std::vector<std::pair<std::string, Table>> tables;    ///< name -> <name>.csv
+  std::vector<std::string> files;                       ///< other files it wrote into the output folder
+};
+
+/// A step callback of simulate() showing progress, or an empty one.
+using ProgressCallback = std::function<void(const SimTK::State&)>;
+/// Makes a progress callback for a run labelled `label` ending at t_end_s.
+using ProgressFactory = std::function<ProgressCallback(const std::string& label, double t_end_s)>;
+
+/// What an analysis runs on.
+struct AnalysisContext {
+  /// The scene file (with overrides): analyses that need fresh scenes (sweeps,
+  /// bisection over speed, design perturbations) build them from it with
+  /// SceneDescription::withOverride(...).build().
+  const SceneDescription& description;
+  /// The scene built once from `description` (vehicle, plugins, outputs).
+  BuiltScene& built;
+  /// Output folder for the analysis's own files ("" = write none).
+  std::string out_dir;
+  /// Progress of long runs (empty = none).
+  ProgressFactory progress;
+};
+
+class Analysis {
+ public:
+  virtual ~Analysis() = default;
+  Analysis(const Analysis&) = delete;
+  Analysis& operator=(const Analysis&) = delete;
+  const std::string& type() const { return type_; }
+
+  /// Runs the analysis. Throws Error naming the cause if it fails; a result
+  /// is never returned for a run that failed or left its regime.
+  AnalysisResult run(const AnalysisContext& context) const;
+
+ protected:
+  explicit Analysis(std::string type) : type_(std::move(type)) {}
+  virtual AnalysisResult DoRun(const AnalysisContext& context) const = 0;
+
+ private:
+  std::string type_;
+};
+
+}  // namespace vdyn

@@ -1,0 +1,348 @@
+#include "vdyn/core/scene_file.h"
+
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+#include "vdyn/core/plugin_library.h"
+
+namespace vdyn {
+
+// ---------------------------------------------------------------------------
+// Table, Analysis
+void Table::writeCsv(const std::string& path) const {
+  std::ofstream out(path);
+  if (!out) throw Error("cannot write '" + path + "'");
+  for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
+  out << '\n' << std::setprecision(17);
+  for (const auto& row : rows) {
+    for (std::size_t i = 0; i < row.size(); ++i) out << (i ? "," : "") << row[i];
+    out << '\n';
+  }
+  if (!out) throw Error("cannot write '" + path + "'");
+}
+
+AnalysisResult Analysis::run(const AnalysisContext& context) const {
+  if (!context.built.vehicle) throw Error(type_ + " analysis: the scene has no vehicle");
+  return DoRun(context);
+}
+
+// ---------------------------------------------------------------------------
+// Overrides
+Override Override::parse(const std::string& text, const std::string& option) {
+  const auto eq = text.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw Error(option + " '" + text + "': expected key.path=value");
+  Override o;
+  o.key_path = text.substr(0, eq);
+  const std::string v = text.substr(eq + 1);
+  try {
+    o.value = Json::parse(v);
+  } catch (const Json::parse_error&) {
+    o.value = v;  // a bare word: a string
+  }
+  return o;
+}
+
+void applyOverride(Json& scene, const Override& o, const std::string& where) {
+  std::vector<std::string> parts;
+  std::string item;
+  for (char c : o.key_path + ".") {
+    if (c == '.') {
+      if (item.empty()) throw Error(where + ": override '" + o.key_path + "': empty key in the path");
+      parts.push_back(item);
+      item.clear();
+    } else {
+      item += c;
+    }
+  }
+  Json* node = &scene;
+  std::string done;
+  for (std::size_t i = 0; i < parts.size(); ++i) {
+    const std::string& p = parts[i];
+    const bool last = i + 1 == parts.size();
+    Json* next = nullptr;
+    if (node->is_array()) {
+      const bool numeric = p.find_first_not_of("0123456789") == std::string::npos;
+      if (numeric) {
+        const std::size_t k = std::stoul(p);
+        if (k >= node->size())
+          throw Error(where + ": override '" + o.key_path + "': " + (done.empty() ? "" : done + " ") + "has " +
+                      std::to_string(node->size()) + " elements, no [" + p + "]");
+        next = &(*node)[k];
+      } else {
+        for (auto& e : *node)
+          if (e.is_object() && e.contains("name") && e["name"] == p) next = &e;
+        if (!next)
+          throw Error(where + ": override '" + o.key_path + "': " + (done.empty() ? "the array" : done) +
+                      " has no element named '" + p + "'");
+      }
+      if (last) *next = o.value;
+    } else if (node->is_object() || node->is_null()) {
+      if (last) {
+        (*node)[p] = o.value;
+        return;
+      }
+      next = &(*node)[p];
+    } else {
+      throw Error(where + ": override '" + o.key_path + "': " + done + " is " + node->dump() +
+                  ", not an object or array");
+    }
+    done += (done.empty() ? "" : ".") + p;
+    node = next;
+  }
+}
+
+// ---------------------------------------------------------------------------
+// SceneDescription
+namespace {
+/// A scene file with "based_on": "<scene>" is that scene with its own keys
+/// merged over it (JSON merge patch), except "analysis", which replaces the
+/// base's whole (a derived scene runs another analysis on the same scene).
+Json readSceneWithBase(const std::string& resolved, int depth) {
+  Json j = readJsonFile(resolved);
+  if (!j.is_object() || !j.contains("based_on")) return j;
+  if (!j["based_on"].is_string()) throw Error(resolved + ": based_on: expected a scene file name, got " + j["based_on"].dump());
+  if (depth >= 8) throw Error(resolved + ": based_on: chain deeper than 8 files (a cycle?)");
+  Json base = readSceneWithBase(resolveDataPath(j["based_on"].get<std::string>(), resolved), depth + 1);
+  j.erase("based_on");
+  if (j.contains("analysis")) base.erase("analysis");
+  base.merge_patch(j);
+  return base;
+}
+}  // namespace
+
+SceneDescription SceneDescription::fromFile(const std::string& path, const PluginRegistry& registry,
+                                            const std::vector<Override>& overrides) {
+  const std::string resolved = resolveDataPath(path);
+  SceneDescription d = fromJson(readSceneWithBase(resolved, 0), resolved, registry);
+  return overrides.empty() ? d : d.withOverrides(overrides);
+}
+
+SceneDescription SceneDescription::fromJson(Json scene, const std::string& sourcePath,
+                                            const PluginRegistry& registry) {
+  if (!scene.is_object()) throw Error((sourcePath.empty() ? "scene" : sourcePath) + ": expected a JSON object");
+  SceneDescription d;
+  d.json_ = std::make_shared<const Json>(std::move(scene));
+  d.path_ = sourcePath;
+  d.registry_ = &registry;
+  return d;
+}
+
+std::string SceneDescription::name() const {
+  if (json_->contains("name") && (*json_)["name"].is_string()) return (*json_)["name"].get<std::string>();
+  std::string n = path_.substr(path_.find_last_of('/') + 1);
+  if (n.size() > 5 && n.substr(n.size() - 5) == ".json") n.resize(n.size() - 5);
+  return n.empty() ? "scene" : n;
+}
+
+SceneDescription SceneDescription::withOverrides(const std::vector<Override>& overrides) const {
+  Json j = *json_;
+  for (const auto& o : overrides) applyOverride(j, o, path_.empty() ? "scene" : path_);
+  SceneDescription d = *this;
+  d.json_ = std::make_shared<const Json>(std::move(j));
+  return d;
+}
+
+std::string SceneDescription::resolve(const std::string& name) const {
+  return resolveDataPath(name, path_.empty() ? "./scene" : path_);
+}
+
+std::vector<std::string> SceneDescription::pluginLibraries() const {
+  std::vector<std::string> libs;
+  if (!json_->contains("plugin_libraries")) return libs;
+  const Json& v = (*json_)["plugin_libraries"];
+  const std::string where = (path_.empty() ? "scene" : path_) + ": plugin_libraries";
+  if (!v.is_array()) throw Error(where + ": expected an array of file names, got " + v.dump());
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (!v[i].is_string())
+      throw Error(where + "[" + std::to_string(i) + "]: expected a file name, got " + v[i].dump());
+    libs.push_back(resolve(v[i].get<std::string>()));
+  }
+  return libs;
+}
+
+namespace {
+/// Prefixes a message with `where` unless it already names the file.
+std::string located(const std::string& where, const std::string& fileTag, const std::string& msg) {
+  if (msg.rfind(fileTag, 0) == 0) return msg;
+  return where + ": " + msg;
+}
+
+/// Resolves the kind of a plugin entry: "kind" if given, else the one kind
+/// (force element, constraint, controller) registering the type.
+PluginKind pluginKind(const ParamReader& e, const std::string& type, const PluginRegistry& reg) {
+  if (e.has("kind")) {
+    const PluginKind k = kindFromKey(e.string("kind"), e.at("kind"));
+    if (k == PluginKind::Vehicle || k == PluginKind::Analysis)
+      throw Error(e.at("kind") + ": a plugin is a force_element, constraint or controller, not '" +
+                  e.string("kind") + "'");
+    return k;
+  }
+  std::vector<PluginKind> found;
+  for (PluginKind k : {PluginKind::ForceElement, PluginKind::Constraint, PluginKind::Controller})
+    if (reg.has(k, type)) found.push_back(k);
+  if (found.size() == 1) return found[0];
+  if (found.empty()) {
+    std::string list;
+    for (PluginKind k : {PluginKind::ForceElement, PluginKind::Constraint, PluginKind::Controller})
+      for (const auto& n : reg.known(k)) list += (list.empty() ? "" : ", ") + n;
+    throw Error(e.at("type") + ": unknown plugin '" + type + "'; known: " + (list.empty() ? "(none)" : list));
+  }
+  throw Error(e.at("type") + ": '" + type + "' is registered for more than one kind; say \"kind\"");
+}
+}  // namespace
+
+BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
+  const std::string file = path_.empty() ? "scene" : path_;
+  const ParamReader root = ParamReader::fromJson(*json_, file);
+  const std::string fileTag = file + ":";
+  // Runs one part; in check mode an error is recorded and the part's keys are
+  // marked read (so they are not reported again as unknown).
+  auto attempt = [&](const std::string& where, const ParamReader* part, const std::function<void()>& f) {
+    try {
+      f();
+      return true;
+    } catch (const Error& e) {
+      if (!errors) throw Error(located(where, fileTag, e.what()));
+      errors->push_back(located(where, fileTag, e.what()));
+      if (part) part->markAllRead();
+      return false;
+    }
+  };
+
+  BuiltScene b;
+  b.name = name();
+  root.stringOr("name", "");
+  root.stringOr("description", "");
+  if (root.has("plugin_libraries")) attempt(root.at("plugin_libraries"), nullptr, [&] { pluginLibraries(); });
+
+  // The vehicle.
+  bool haveVehicle = false;
+  {
+    std::unique_ptr<ParamReader> v;
+    attempt(root.at("vehicle"), nullptr, [&] { v = std::make_unique<ParamReader>(root.child("vehicle")); });
+    if (v)
+      haveVehicle = attempt(v->where(), v.get(), [&] {
+        const std::string type = v->string("type");
+        b.initial_speed_m_s = v->numberOr("initial_speed_m_s", 0.0);
+        const std::string dataFile = resolveDataPath(v->string("data"), file);
+        Json data = ParamReader::fromFile(dataFile).json();
+        if (v->has("overrides")) data.merge_patch(v->child("overrides").json());
+        const std::string dataName = dataFile.substr(dataFile.find_last_of('/') + 1);
+        const VehicleSpec spec{type, ParamReader::fromJson(std::move(data), dataName), registry_};
+        b.vehicle = registry_->createVehicle(type, spec, v->at("type"));
+        if (v->has("overrides")) v->child("overrides").markAllRead();  // read by the vehicle's own loader
+      });
+  }
+
+  // Plugins, in order (a controller names the steering plugin added before it).
+  if (root.has("plugins")) {
+    std::vector<ParamReader> entries;
+    attempt(root.at("plugins"), nullptr, [&] { entries = root.array("plugins"); });
+    for (const ParamReader& e : entries) {
+      attempt(e.where(), &e, [&] {
+        const std::string type = e.string("type");
+        const std::string name = e.string("name");
+        const PluginKind kind = pluginKind(e, type, *registry_);
+        if (!registry_->has(kind, type)) registry_->create(kind, type, PluginSpec{name, e}, e.at("type"));
+        if (!haveVehicle) {
+          e.markAllRead();  // the vehicle's error is reported; its plugins cannot be built
+          return;
+        }
+        Attachment bindings;
+        if (e.has("attach")) bindings = b.vehicle->getAttachment(e.string("attach"));
+        if (e.has("bindings")) {
+          const ParamReader bind = e.child("bindings");
+          for (auto it = bind.json().begin(); it != bind.json().end(); ++it) bindings[it.key()] = bind.string(it.key());
+        }
+        b.scene().addPlugin(registry_->create(kind, type, PluginSpec{name, e, bindings}, e.at("type")));
+      });
+    }
+  }
+
+  // Outputs to record.
+  if (root.has("outputs")) {
+    attempt(root.at("outputs"), nullptr, [&] {
+      const Json& v = root.json().at("outputs");
+      if (!v.is_array()) throw Error(root.at("outputs") + ": expected an array of output names, got " + v.dump());
+      for (std::size_t i = 0; i < v.size(); ++i) {
+        const std::string where = root.at("outputs") + "[" + std::to_string(i) + "]";
+        if (!v[i].is_string()) throw Error(where + ": expected an output name, got " + v[i].dump());
+        const std::string n = v[i].get<std::string>();
+        if (haveVehicle && !b.scene().hasOutput(n)) {
+          std::string list;
+          for (const auto& k : b.scene().getOutputNames()) list += (list.empty() ? "" : ", ") + k;
+          if (errors) errors->push_back(where + ": the scene has no output '" + n + "'; known: " + list);
+          else throw Error(where + ": the scene has no output '" + n + "'; known: " + list);
+        }
+        b.outputs.push_back(n);
+      }
+    });
+  }
+
+  // The analysis (its factory reads and checks the settings).
+  {
+    std::unique_ptr<ParamReader> a;
+    attempt(root.at("analysis"), nullptr, [&] { a = std::make_unique<ParamReader>(root.child("analysis")); });
+    if (a)
+      attempt(a->where(), a.get(), [&] {
+        const std::string type = a->string("type");
+        b.analysis = registry_->createAnalysis(type, *a, a->at("type"));
+      });
+  }
+
+  // Every key of the file was asked for by someone.
+  const auto unread = root.unreadKeys();
+  if (errors) {
+    errors->insert(errors->end(), unread.begin(), unread.end());
+  } else if (!unread.empty()) {
+    root.requireAllKeysRead();
+  }
+  return b;
+}
+
+BuiltScene SceneDescription::build() const { return load(nullptr); }
+
+std::vector<std::string> SceneDescription::check() const {
+  std::vector<std::string> errors;
+  load(&errors);
+  return errors;
+}
+
+void loadSceneLibraries(const SceneDescription& scene, PluginRegistry& registry) {
+  for (const auto& lib : scene.pluginLibraries()) loadPluginLibrary(lib, registry);
+}
+
+std::string defaultOutputDir(const SceneDescription& scene) { return "results/" + scene.name(); }
+
+Json runScene(const SceneDescription& scene, const RunOptions& options) {
+  BuiltScene built = scene.build();
+  if (!options.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(options.out_dir, ec);
+    if (ec) throw Error("cannot create output folder '" + options.out_dir + "': " + ec.message());
+  }
+  const AnalysisContext ctx{scene, built, options.out_dir, options.progress};
+  AnalysisResult r = built.analysis->run(ctx);
+  Json summary = {{"scene", scene.name()}, {"analysis", built.analysis->type()}};
+  for (auto it = r.summary.begin(); it != r.summary.end(); ++it) summary[it.key()] = it.value();
+  if (!options.out_dir.empty()) {
+    for (const auto& [name, table] : r.tables) table.writeCsv(options.out_dir + "/" + name + ".csv");
+    const std::string path = options.out_dir + "/summary.json";
+    std::ofstream out(path);
+    if (!out) throw Error("cannot write '" + path + "'");
+    out << std::setprecision(17) << summary.dump(2) << '\n';
+  }
+  return summary;
+}
+
+Json runSceneFile(const std::string& path, const std::vector<Override>& overrides, PluginRegistry& registry,
+                  const RunOptions& options) {
+  const SceneDescription scene = SceneDescription::fromFile(path, registry, overrides);
+  loadSceneLibraries(scene, registry);
+  return runScene(scene, options);
+}
+
+}  // namespace vdyn

@@ -1,0 +1,83 @@
+#pragma once
+// The built-in analyses a scene file names by "analysis": {"type": ...}, and
+// the reusable pieces the chapter programs compose from (runTransient).
+//
+//   transient           integrate the scene (simulate) and report final values,
+//                       peaks, cost integrals and the run's statistics
+//   static_equilibrium  solveStaticEquilibrium at zero speed
+//   steady_state        SteadyStateSolver on the chassis turning problem
+//   continuation        followSteadyState over speed or a steering angle
+//   stability           linearised eigenvalues at the steady state
+//   sensitivity         d cost / d parameters, parameters = key paths of the scene
+//   optimal_ratio       nonlinear optimal 4WS ratio Kr(delta_f) at the scene's speed
+#include <string>
+#include <vector>
+
+#include "vdyn/core/analysis.h"
+#include "vdyn/core/fields.h"
+#include "vdyn/core/recorder.h"
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/core/simulation.h"
+#include "vdyn/sensitivity/design.h"
+
+namespace vdyn {
+
+/// Settings of the transient analysis (keys of the scene's "analysis" object).
+struct TransientSettings {
+  double t_end_s = 1.0;               ///< end time, s
+  double report_interval_s = 0.01;    ///< sampling interval of the recorded outputs, s (0 = none)
+  IntegratorSettings integrator;      ///< "integrator": {method, accuracy, constraint_tolerance, max_step_s}
+  /// Outputs y whose int_0^T y^2 dt is carried as an error-controlled state (seed 4.46).
+  std::vector<std::string> integrals_of_square;
+  bool write_history = true;          ///< write history.csv of the recorded outputs
+
+  static const FieldTable<TransientSettings>& fields();
+  SimulationSettings simulation() const;
+};
+
+/// A finished transient run.
+struct TransientRun {
+  SimTK::State final_state;
+  RunSummary run;
+  std::unique_ptr<Recorder> recorder;      ///< the scene's "outputs" sampled every report interval
+  std::vector<double> integrals;           ///< one per TransientSettings::integrals_of_square
+  Json vehicle;                            ///< Vehicle::describe at the initial state
+};
+
+/// Runs the built scene from its initial state to settings.t_end_s, recording
+/// `built.outputs`. `progress` may be empty. The one transient run the
+/// transient analysis and the chapter programs share.
+TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, const ProgressFactory& progress = {});
+
+/// The transient analysis's summary of a run: "final" (every scene output at
+/// the end), "peak_abs" (largest |value| of each recorded output), "rms" (root
+/// mean square over the samples of each recorded output), "integrals",
+/// "run" (steps, realizations, max_constraint_error, wall_time_s, ...) and "vehicle".
+Json summarizeTransient(const BuiltScene& built, const TransientSettings& settings, const TransientRun& r);
+
+/// The design model of a scene (chapter 4): parameters are key paths of the
+/// scene; "vehicle.data.<path>" names a value of the vehicle data file (set
+/// through vehicle.overrides). Each design builds a fresh scene from the
+/// description with the values as overrides.
+class SceneDesign : public DesignModel {
+ public:
+  SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params);
+  /// Parameters at the scene's nominal values (scale = |nominal|, or 1 if 0);
+  /// throws Error naming a path that is not a number in the scene or data file.
+  static std::vector<DesignParameter> parametersOf(const SceneDescription& scene,
+                                                   const std::vector<std::string>& keyPaths);
+  std::string describe() const override { return "scene '" + scene_.name() + "'"; }
+
+ protected:
+  std::unique_ptr<DesignInstance> DoBuild(const std::vector<double>& values) const override;
+
+ private:
+  SceneDescription scene_;
+  std::vector<std::string> paths_;
+};
+
+/// Registers every built-in analysis.
+void registerAnalyses(PluginRegistry& registry);
+
+}  // namespace vdyn

@@ -1,0 +1,192 @@
+// The sensitivity analysis (chapter 4) on any scene: design parameters are key
+// paths of the scene ("vehicle.data.front_right.spring.stiffness_N_per_m" is a
+// value of the vehicle's data file, set through vehicle.overrides; any other
+// path is a scene value, e.g. "plugins.speed_hold.speed_m_s"), so the design
+// model is the scene description itself (SceneDesign) and each perturbed
+// design is a fresh scene built from it.
+#include <algorithm>
+#include <cmath>
+
+#include "vdyn/analyses/analyses.h"
+#include "vdyn/sensitivity/sensitivity.h"
+
+namespace vdyn {
+
+namespace {
+constexpr const char* kData = "vehicle.data.";
+
+/// The value at a dotted key path of a JSON object (objects only).
+const Json* at(const Json& j, const std::string& path) {
+  const Json* node = &j;
+  std::size_t start = 0;
+  while (start <= path.size()) {
+    const std::size_t end = std::min(path.find('.', start), path.size());
+    const std::string key = path.substr(start, end - start);
+    if (!node->is_object() || !node->contains(key)) return nullptr;
+    node = &(*node)[key];
+    start = end + 1;
+  }
+  return node;
+}
+
+class SceneInstance : public DesignInstance {
+ public:
+  explicit SceneInstance(BuiltScene b) : b_(std::move(b)) {}
+  Scene& updScene() override { return b_.scene(); }
+  const Scene& getScene() const override { return b_.scene(); }
+  SimTK::State makeInitialState() const override { return b_.makeInitialState(); }
+
+ private:
+  BuiltScene b_;
+};
+}  // namespace
+
+SceneDesign::SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params)
+    : DesignModel(params), scene_(scene) {
+  for (const auto& p : params) paths_.push_back(p.name);
+}
+
+std::vector<DesignParameter> SceneDesign::parametersOf(const SceneDescription& scene,
+                                                       const std::vector<std::string>& keyPaths) {
+  std::unique_ptr<Json> data;
+  std::vector<DesignParameter> out;
+  for (const auto& path : keyPaths) {
+    const Json* v = nullptr;
+    if (path.rfind(kData, 0) == 0) {
+      const std::string rest = path.substr(std::string(kData).size());
+      const Json& sj = scene.json();
+      if (sj.contains("vehicle") && sj["vehicle"].contains("overrides")) v = at(sj["vehicle"]["overrides"], rest);
+      if (!v) {
+        if (!data) {
+          const std::string file = scene.resolve(sj.at("vehicle").at("data").get<std::string>());
+          data = std::make_unique<Json>(ParamReader::fromFile(file).json());
+        }
+        v = at(*data, rest);
+      }
+    } else {
+      v = at(scene.json(), path);
+    }
+    if (!v || !v->is_number())
+      throw Error("sensitivity parameter '" + path + "': " + (v ? "not a number: " + v->dump() : "no such value") +
+                  " in the scene (vehicle.data.<key path> names a value of the vehicle data file)");
+    const double nominal = v->get<double>();
+    DesignParameter p;
+    p.name = path;
+    p.symbol = path;
+    p.unit = "";
+    p.nominal = nominal;
+    p.scale = nominal != 0 ? std::abs(nominal) : 1.0;
+    out.push_back(p);
+  }
+  return out;
+}
+
+std::unique_ptr<DesignInstance> SceneDesign::DoBuild(const std::vector<double>& values) const {
+  std::vector<Override> overrides;
+  for (std::size_t i = 0; i < values.size(); ++i) {
+    const std::string& path = paths_[i];
+    const std::string target =
+        path.rfind(kData, 0) == 0 ? "vehicle.overrides." + path.substr(std::string(kData).size()) : path;
+    overrides.push_back({target, values[i]});
+  }
+  return std::make_unique<SceneInstance>(scene_.withOverrides(overrides).build());
+}
+
+namespace {
+struct SensitivityEntry {
+  std::vector<std::string> parameters;
+  std::vector<double> scales;
+  std::string cost;
+  std::vector<std::string> methods = {"fd_central"};
+  double t_end_s = 1.0;
+  IntegratorSettings integrator;
+  SensitivitySettings settings;
+  double tolerance = SensitivitySettings{}.tolerance;
+  double perturbation = 0;
+};
+
+const FieldTable<SensitivityEntry>& sensitivityFields() {
+  using E = SensitivityEntry;
+  static const auto t =
+      FieldTable<E>()
+          .strings("parameters", &E::parameters,
+                   "design parameters b: scene key paths; vehicle.data.<path> = a value of the vehicle data file")
+          .numbers("scales", &E::scales, "(parameter's)",
+                   "typical size of each parameter: perturbations scale with max(|b|, scale) (default |b|, or 1 if 0)")
+          .string("cost", &E::cost, "integral_of_square|maximum|final_value:<output> (4.46)", true)
+          .strings("methods", &E::methods, "fd_forward | fd_central | mixed | reference, each run in turn")
+          .number("t_end_s", &E::t_end_s, "s", "cost horizon")
+          .custom("integrator", "-", "{\"method\": \"rk_merson\", \"accuracy\": 1e-6}", "integrator of the runs",
+                  [](const ParamReader& r, E& e) {
+                    if (r.has("integrator")) e.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+                  })
+          .number("tolerance", &E::tolerance, "", "mixed: relative tolerance on the error estimate")
+          .number("perturbation", &E::perturbation, "", "finite differences: relative step (0 = from the accuracy)");
+  return t;
+}
+
+class SensitivityAnalysis : public Analysis {
+ public:
+  explicit SensitivityAnalysis(const ParamReader& r) : Analysis("sensitivity") {
+    sensitivityFields().read(r, e_);
+    if (e_.parameters.empty()) throw Error(r.at("parameters") + ": name at least one design parameter");
+    if (!e_.scales.empty() && e_.scales.size() != e_.parameters.size())
+      throw Error(r.at("scales") + ": one scale per parameter (" + std::to_string(e_.parameters.size()) + "), got " +
+                  std::to_string(e_.scales.size()));
+    for (double x : e_.scales) requirePositive(x, r.at("scales"));
+    cost_ = CostFunctional::parse(e_.cost);
+    for (const auto& m : e_.methods) makeSensitivityMethod(m);  // named error now, not after a run
+    requirePositive(e_.t_end_s, r.at("t_end_s"));
+    e_.settings.tolerance = e_.tolerance;
+    e_.settings.perturbation = e_.perturbation;
+  }
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    SensitivityProblem problem;
+    auto params = SceneDesign::parametersOf(ctx.description, e_.parameters);
+    for (std::size_t i = 0; i < e_.scales.size(); ++i) params[i].scale = e_.scales[i];
+    problem.model = std::make_shared<SceneDesign>(ctx.description, params);
+    problem.parameters = e_.parameters;
+    problem.cost = cost_;
+    problem.t_end_s = e_.t_end_s;
+    problem.integrator = e_.integrator;
+    problem.validate();
+    AnalysisResult res;
+    res.summary["parameters"] = e_.parameters;
+    res.summary["cost"] = cost_.describe();
+    Table t;
+    t.columns = {"method_index", "parameter_index", "dpsi_db", "error_estimate"};
+    Json methods = Json::object();
+    for (std::size_t m = 0; m < e_.methods.size(); ++m) {
+      const SensitivityResult r = makeSensitivityMethod(e_.methods[m], e_.settings)->compute(problem);
+      res.summary["psi"] = r.psi;
+      methods[r.method] = {{"psi", r.psi},
+                           {"dpsi_db", r.dpsi_db},
+                           {"error_estimate", r.error_estimate},
+                           {"perturbation", r.perturbation},
+                           {"wall_time_s", r.wall_time_s},
+                           {"simulations", r.simulations}};
+      for (std::size_t i = 0; i < r.dpsi_db.size(); ++i)
+        t.rows.push_back({double(m), double(i), r.dpsi_db[i], i < r.error_estimate.size() ? r.error_estimate[i] : NAN});
+    }
+    res.summary["methods"] = methods;
+    res.tables.push_back({"sensitivity", t});
+    return res;
+  }
+
+ private:
+  SensitivityEntry e_;
+  CostFunctional cost_;
+};
+}  // namespace
+
+void registerSensitivityAnalysis(PluginRegistry& registry) {
+  registry.addAnalysis(
+      "sensitivity", [](const ParamReader& r) { return std::make_unique<SensitivityAnalysis>(r); },
+      {"design sensitivity d psi / d b (ch. 4) of a cost over the transient, by finite differences, the mixed "
+       "method or the reference; parameters are scene key paths (SceneDesign)",
+       sensitivityFields().describe()});
+}
+
+}  // namespace vdyn

@@ -1,0 +1,133 @@
+#include <cmath>
+
+#include "vdyn/analyses/analyses.h"
+
+namespace vdyn {
+
+const FieldTable<TransientSettings>& TransientSettings::fields() {
+  static const auto t =
+      FieldTable<TransientSettings>()
+          .number("t_end_s", &TransientSettings::t_end_s, "s", "end time of the run (from t = 0)")
+          .number("report_interval_s", &TransientSettings::report_interval_s, "s",
+                  "sampling interval of the recorded outputs (interpolated, never forces a step; 0 = none)")
+          .custom("integrator", "-", "{\"method\": \"rk_merson\", \"accuracy\": 1e-6, \"constraint_tolerance\": 1e-10}",
+                  "integrator: method rk_merson|rk3|rk_feldberg|cpodes|verlet|semi_explicit_euler2, accuracy, "
+                  "constraint_tolerance, max_step_s",
+                  [](const ParamReader& r, TransientSettings& s) {
+                    if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+                  })
+          .strings("integrals_of_square", &TransientSettings::integrals_of_square,
+                   "outputs y whose int y^2 dt is integrated with error control (cost, seed 4.46)")
+          .boolean("write_history", &TransientSettings::write_history, "write history.csv of the recorded outputs");
+  return t;
+}
+
+SimulationSettings TransientSettings::simulation() const {
+  SimulationSettings s;
+  s.t_end_s = t_end_s;
+  s.report_interval_s = report_interval_s;
+  s.integrator = integrator;
+  return s;
+}
+
+TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, const ProgressFactory& progress) {
+  requirePositive(settings.t_end_s, "transient t_end_s");
+  Scene& scene = built.scene();
+  std::vector<IntegralHandle> handles;
+  for (const auto& name : settings.integrals_of_square) handles.push_back(scene.addIntegralOfSquare(name));
+  TransientRun r;
+  r.final_state = built.makeInitialState();
+  r.vehicle = built.vehicle->describe(r.final_state);
+  if (!built.outputs.empty()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
+  const SimulationSettings sim = settings.simulation();
+  ProgressCallback cb = progress ? progress(built.name, sim.t_end_s) : ProgressCallback{};
+  r.run = simulate(scene, r.final_state, sim, r.recorder.get(), cb);
+  for (const auto& h : handles) r.integrals.push_back(scene.getIntegral(h, r.final_state));
+  return r;
+}
+
+Json summarizeTransient(const BuiltScene& built, const TransientSettings& settings, const TransientRun& r) {
+  const Scene& scene = built.scene();
+  Json final = Json::object();
+  for (const auto& name : scene.getOutputNames()) {
+    const double v = scene.evalOutput(name, r.final_state);
+    if (!std::isfinite(v)) throw Error("transient: output '" + name + "' is " + formatValue(v) + " at the end of the run");
+    final[name] = v;
+  }
+  Json peaks = Json::object(), rms = Json::object();
+  if (r.recorder)
+    for (const auto& name : r.recorder->names()) {
+      double peak = 0, sum = 0;
+      const auto& col = r.recorder->column(name);
+      for (double v : col) {
+        peak = std::max(peak, std::abs(v));
+        sum += v * v;
+      }
+      peaks[name] = peak;
+      rms[name] = col.empty() ? 0.0 : std::sqrt(sum / col.size());
+    }
+  Json integrals = Json::object();
+  for (std::size_t i = 0; i < r.integrals.size(); ++i) integrals[settings.integrals_of_square[i]] = r.integrals[i];
+  const RunSummary& run = r.run;
+  return {{"final", final},
+          {"peak_abs", peaks},
+          {"rms", rms},
+          {"integrals", integrals},
+          {"run",
+           {{"integrator", run.integrator},
+            {"accuracy", run.accuracy},
+            {"steps", run.steps},
+            {"attempts", run.attempts},
+            {"realizations", run.realizations},
+            {"projections", run.projections},
+            {"max_constraint_error", run.max_constraint_error},
+            {"sim_time_s", run.sim_time_s},
+            {"wall_time_s", run.wall_time_s},
+            {"real_time_factor", run.sim_time_s / run.wall_time_s}}},
+          {"vehicle", r.vehicle}};
+}
+
+namespace {
+Table historyTable(const Recorder& rec) {
+  Table t;
+  t.columns.push_back("t_s");
+  for (const auto& n : rec.names()) t.columns.push_back(n);
+  for (std::size_t i = 0; i < rec.size(); ++i) {
+    std::vector<double> row{rec.time()[i]};
+    for (const auto& n : rec.names()) row.push_back(rec.column(n)[i]);
+    t.rows.push_back(std::move(row));
+  }
+  return t;
+}
+
+class TransientAnalysis : public Analysis {
+ public:
+  explicit TransientAnalysis(const ParamReader& r) : Analysis("transient") {
+    TransientSettings::fields().read(r, s_);
+    s_.simulation().validate();
+    requirePositive(s_.t_end_s, r.at("t_end_s"));
+  }
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    const TransientRun run = runTransient(ctx.built, s_, ctx.progress);
+    AnalysisResult res;
+    res.summary = summarizeTransient(ctx.built, s_, run);
+    if (run.recorder && s_.write_history) res.tables.push_back({"history", historyTable(*run.recorder)});
+    return res;
+  }
+
+ private:
+  TransientSettings s_;
+};
+}  // namespace
+
+void registerTransientAnalysis(PluginRegistry& registry) {
+  registry.addAnalysis(
+      "transient", [](const ParamReader& r) { return std::make_unique<TransientAnalysis>(r); },
+      {"integrate the scene from its initial state (simulate); summary: final outputs, peaks, cost integrals, "
+       "run statistics; table history.csv",
+       TransientSettings::fields().describe()});
+}
+
+}  // namespace vdyn

@@ -1,0 +1,40 @@
+// vdyn run SCENE: load, override, run the scene's analysis, write the results.
+#include <cstdio>
+#include <iostream>
+
+#include "command.h"
+#include "vdyn/core/scene_file.h"
+
+namespace vdyn::cli {
+
+int runCommand(const std::vector<std::string>& args) {
+  namespace po = study::po;
+  po::options_description opts("Options");
+  opts.add_options()("scene", po::value<std::string>(), "scene file (path, or a name along the data path)")(
+      "set", po::value<std::vector<std::string>>()->composing(),
+      "override a scene value: key.path=value (repeatable; e.g. vehicle.initial_speed_m_s=12, "
+      "plugins.front_steer.command.final_rad=0.05, analysis.t_end_s=5)")(
+      "out", po::value<std::string>(), "output folder (default: ./results/<scene name>)");
+  addCommonOptions(opts);
+  po::variables_map vm;
+  if (!parseArgs(command("run"), args, opts, {"scene"}, vm)) return 0;
+  if (!vm.count("scene")) throw Error("bad command line: no scene file given (vdyn run SCENE)");
+  PluginRegistry& registry = registryWithPlugins(vm);
+  std::vector<Override> overrides;
+  if (vm.count("set"))
+    for (const auto& s : vm["set"].as<std::vector<std::string>>()) overrides.push_back(Override::parse(s, "--set"));
+  const SceneDescription scene = SceneDescription::fromFile(vm["scene"].as<std::string>(), registry, overrides);
+  loadSceneLibraries(scene, registry);
+  RunOptions options;
+  options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : defaultOutputDir(scene);
+  options.progress = [](const std::string& label, double tEnd) { return study::progress(label, tEnd); };
+  const Json summary = runScene(scene, options);
+  study::endProgress();
+  std::printf("vdyn run: %s (%s): %s/summary.json\n", scene.name().c_str(),
+              summary.value("analysis", std::string("?")).c_str(), options.out_dir.c_str());
+  for (auto it = summary.begin(); it != summary.end(); ++it)
+    if (it.value().is_number()) std::printf("  %-32s %.10g\n", it.key().c_str(), it.value().get<double>());
+  return 0;
+}
+
+}  // namespace vdyn::cli

@@ -1,0 +1,156 @@
+// Scene-file adaptors of the built-in vehicles: each owns the concrete vehicle
+// (QuarterCar, Bicycle, FourWsVehicle) and exposes its scene, attachments and
+// initial state through vdyn::Vehicle.
+#include "vdyn/vehicles/scene_vehicles.h"
+
+#include "vdyn/vehicles/bicycle.h"
+#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/quarter_car.h"
+
+namespace vdyn {
+
+namespace {
+
+std::string axisText(const SimTK::Vec3& a) {
+  return formatValue(a[0]) + " " + formatValue(a[1]) + " " + formatValue(a[2]);
+}
+
+/// Scene keys every vehicle takes (read by the scene loader).
+std::vector<FieldInfo> sceneVehicleKeys() {
+  return {{"data", "-", "required", "vehicle data file (resolved from the scene file's folder, then the data path)"},
+          {"overrides", "-", "{}", "object merged over the data file (JSON merge patch): change a value inline"},
+          {"initial_speed_m_s", "m/s", "0", "forward speed of the initial state (wheels rolling)"}};
+}
+
+class FourWsSceneVehicle : public Vehicle {
+ public:
+  FourWsSceneVehicle(const VehicleSpec& spec)
+      : Vehicle("fourws"), car_(FourWsParams::fromParams(spec.data), *spec.registry) {
+    attachments_["chassis"] = {{"chassis", "chassis"}};
+    attachments_["wheels"] = {{"chassis", "chassis"}, {"wheels", "rf.wheel,lf.wheel,rr.wheel,lr.wheel"}};
+    for (int axle = 0; axle < 2; ++axle) {
+      const int r = axle == 0 ? RF : RR, l = axle == 0 ? LF : LR;
+      attachments_[axle == 0 ? "front_axle" : "rear_axle"] = {
+          {"chassis", "chassis"},
+          {"knuckles", std::string(cornerName(r)) + ".knuckle," + cornerName(l) + ".knuckle"},
+          {"spin_axis", axisText(car_.cornerParams(r).wheel_spin_axis)}};
+    }
+    for (int c = 0; c < 4; ++c) {
+      const std::string n = cornerName(c);
+      attachments_[n] = {{"chassis", "chassis"},
+                         {"wheel", n + ".wheel"},
+                         {"knuckle", n + ".knuckle"},
+                         {"knuckles", n + ".knuckle"},
+                         {"spin_axis", axisText(car_.cornerParams(c).wheel_spin_axis)}};
+    }
+  }
+  FourWsVehicle& car() { return car_; }
+
+ protected:
+  Scene& DoUpdScene() override { return car_.updScene(); }
+  SimTK::State DoMakeInitialState(double speed) const override {
+    return car_.makeInitialState(speed, &assembly_);
+  }
+  Json DoDescribe(const SimTK::State& s) const override {
+    return {{"total_mass_kg", car_.totalMass()},
+            {"dof", car_.degreesOfFreedom(s)},
+            {"assembly_max_body_move_m", assembly_.max_move_m}};
+  }
+
+ private:
+  FourWsVehicle car_;
+  mutable AssemblyReport assembly_;
+};
+
+class BicycleSceneVehicle : public Vehicle {
+ public:
+  BicycleSceneVehicle(const VehicleSpec& spec)
+      : Vehicle("bicycle"), bike_(BicycleParams::fromParams(spec.data), *spec.registry) {
+    attachments_["chassis"] = {{"chassis", "chassis"}};
+    attachments_["front_axle"] = {{"chassis", "chassis"}, {"knuckles", "fork"}, {"wheel", "front_axle"}};
+    attachments_["rear_axle"] = {{"chassis", "chassis"}, {"wheel", "rear_axle"}};
+    attachments_["wheels"] = {{"chassis", "chassis"}, {"wheels", "front_axle,rear_axle"}};
+  }
+
+ protected:
+  Scene& DoUpdScene() override { return bike_.updScene(); }
+  SimTK::State DoMakeInitialState(double speed) const override { return bike_.makeInitialState(speed); }
+  Json DoDescribe(const SimTK::State& s) const override {
+    return {{"total_mass_kg", bike_.totalMass()},
+            {"dof", bike_.degreesOfFreedom(s)},
+            {"front_axle_distance_m", bike_.distanceToFrontAxle()},
+            {"rear_axle_distance_m", bike_.distanceToRearAxle()}};
+  }
+
+ private:
+  Bicycle bike_;
+};
+
+class QuarterCarSceneVehicle : public Vehicle {
+ public:
+  QuarterCarSceneVehicle(const VehicleSpec& spec)
+      : Vehicle("quarter_car"), car_(QuarterCarParams::fromParams(spec.data), *spec.registry) {
+    attachments_["chassis"] = {{"chassis", "chassis"}};
+    attachments_["corner"] = {{"chassis", "chassis"}, {"wheel", "wheel"}, {"knuckle", "knuckle"}};
+  }
+
+ protected:
+  Scene& DoUpdScene() override { return car_.updScene(); }
+  SimTK::State DoMakeInitialState(double speed) const override {
+    if (speed != 0)
+      throw Error("quarter_car: initial_speed_m_s must be 0 (the chassis moves only vertically), got " +
+                  formatValue(speed));
+    return car_.makeInitialState(true, &assembly_);
+  }
+  Json DoDescribe(const SimTK::State& s) const override {
+    return {{"total_mass_kg", car_.totalMass()},
+            {"dof", car_.degreesOfFreedom(s)},
+            {"assembly_max_body_move_m", assembly_.max_move_m},
+            {"assembly_initial_loop_gap_m", assembly_.initial_loop_gap_m}};
+  }
+
+ private:
+  QuarterCar car_;
+  mutable AssemblyReport assembly_;
+};
+
+TypeInfo info(const std::string& summary, std::vector<FieldInfo> dataKeys) {
+  TypeInfo t{summary, sceneVehicleKeys()};
+  for (auto& f : dataKeys) {
+    f.key = "data: " + f.key;
+    t.fields.push_back(std::move(f));
+  }
+  return t;
+}
+
+}  // namespace
+
+void registerVehicles(PluginRegistry& registry) {
+  registry.addVehicle(
+      "fourws", [](const VehicleSpec& s) { return std::make_unique<FourWsSceneVehicle>(s); },
+      info("App. A 4WS vehicle: free chassis, four double-wishbone corners, four tires; attachments chassis, "
+           "front_axle, rear_axle, rf, lf, rr, lr",
+           {{"chassis", "-", "required", "rigid body: mass_kg, inertia_kg_m2, ... (appendix_a.json)"},
+            {"front_right", "-", "required", "double-wishbone corner (LF mirrored from it)"},
+            {"rear_right", "-", "required", "double-wishbone corner (LR mirrored from it)"},
+            {"tire", "-", "required", "{\"plugin\": gim|fiala|linear|..., \"params\": {tire keys}}"},
+            {"road", "-", "flat", "road: {\"type\": flat|sine, ...}"},
+            {"gravity_m_per_s2", "m/s^2", "9.81", "gravity along -z"}}));
+  registry.addVehicle(
+      "bicycle", [](const VehicleSpec& s) { return std::make_unique<BicycleSceneVehicle>(s); },
+      info("nonlinear bicycle (section 7.1): free chassis, steered fork, two axles of two tires; attachments "
+           "chassis, front_axle, rear_axle",
+           {{"vehicle_data", "-", "required", "App. A vehicle data file the axles are lumped from"},
+            {"fork", "-", "required", "rigid body of the steered fork"},
+            {"tire", "-", "the vehicle's", "{\"plugin\", \"params\"} merged over the vehicle data's tire"}}));
+  registry.addVehicle(
+      "quarter_car", [](const VehicleSpec& s) { return std::make_unique<QuarterCarSceneVehicle>(s); },
+      info("chapter 4 quarter car: App. A corner under a chassis on a vertical slider; attachments chassis, corner",
+           {{"vehicle_data", "-", "required", "App. A vehicle data file the corner and tire come from"},
+            {"corner", "-", "\"front_right\"", "which corner of the vehicle data"},
+            {"corner_overrides", "-", "{}", "keys merged over the corner"},
+            {"chassis_mass_kg", "kg", "required", "quarter of the chassis mass (m1)"},
+            {"road", "-", "required", "road: {\"type\": flat|sine, ...}"}}));
+}
+
+}  // namespace vdyn
