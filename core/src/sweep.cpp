@@ -451,7 +451,8 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
     for (std::size_t i = 0; i < plots.size(); ++i) {
       const std::string w = atIndex(wp, i);
       const Json& pj = requireObject(plots[i], w);
-      requireKnownKeys(pj, {"png", "title", "x", "y", "x_scale", "y_scale", "x_label", "y_label", "series", "panels"},
+      requireKnownKeys(pj, {"png", "title", "x", "y", "x_scale", "y_scale", "x_label", "y_label", "series", "panels",
+                            "series_label", "panel_label"},
                        w);
       auto text = [&](const char* key, bool required) {
         if (!pj.contains(key)) {
@@ -485,6 +486,8 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
       p.panels = column("panels", false);
       p.x_label = text("x_label", false);
       p.y_label = text("y_label", false);
+      p.series_label = text("series_label", false);
+      p.panel_label = text("panel_label", false);
       if (pj.contains("x_scale")) p.x_scale = requireNumber(pj["x_scale"], at(w, "x_scale"));
       if (pj.contains("y_scale")) p.y_scale = requireNumber(pj["y_scale"], at(w, "y_scale"));
       d.plots.push_back(p);

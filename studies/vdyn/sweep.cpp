@@ -84,7 +84,9 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
     if (panels.size() > 1 || !p.title.empty())
       g << "set multiplot layout " << rows << "," << cols << " title " << gpQuote(p.title) << " noenhanced\n";
     for (const std::string& panel : panels) {
-      if (!p.panels.empty()) g << "set title " << gpQuote(lastSegment(p.panels) + " = " + panel) << " noenhanced\n";
+      if (!p.panels.empty())
+        g << "set title " << gpQuote((p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel)
+          << " noenhanced\n";
       g << "plot ";
       bool first = true;
       for (const std::string& s : series) {
@@ -94,7 +96,8 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
         g << (first ? "" : ", \\\n     ") << gpQuote(csv) << " using (column(" << gpQuote(p.x) << ")*" << formatValue(p.x_scale)
           << "):((" << cond << ") ? column(" << gpQuote(p.y) << ")*" << formatValue(p.y_scale)
           << " : NaN) with linespoints lw 2 pt 7 ps 0.6 title "
-          << gpQuote(p.series.empty() ? lastSegment(p.y) : lastSegment(p.series) + " = " + s);
+          << gpQuote(p.series.empty() ? lastSegment(p.y)
+                                      : (p.series_label.empty() ? lastSegment(p.series) : p.series_label) + " = " + s);
         first = false;
       }
       g << "\n";

@@ -97,6 +97,7 @@ struct SweepPlot {
   std::string x_label, y_label; ///< axis labels (default: the column names)
   std::string series;           ///< column: one line per value ("" = one line)
   std::string panels;           ///< column: one panel per value ("" = one panel)
+  std::string series_label, panel_label;  ///< legend / panel title prefixes (default: the column's last segment)
 };
 
 struct SweepDescription {
@@ -126,7 +127,8 @@ struct SweepDescription {
   ///   "output": "folder"                 relative to the sweep file
   ///   "plots": [{"png": "f.png", "x": column, "y": column, "series": column,
   ///              "panels": column, "title", "x_label", "y_label", "x_scale",
-  ///              "y_scale"}]               columns: varied keys or collected paths
+  ///              "y_scale", "series_label", "panel_label"}]
+  ///                                      columns: varied keys or collected paths
   /// Unknown keys, wrong types, empty sets and duplicate keys are vdyn::Error
   /// naming the file, the key path and the value.
   static SweepDescription fromFile(const std::string& path);
