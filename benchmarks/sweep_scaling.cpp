@@ -3,10 +3,11 @@
 // processes, the runner's own overhead per run, and the serial fraction that
 // predicts the speed-up on N cores (Amdahl: S(N) = 1 / (f + (1 - f) / N)).
 //
-// Workload: the chapter 3 manoeuvre (studies/common/ch3_case.h, the 4WS
-// vehicle at 10 m/s with a steer step) with t_end from --t-min-s to --t-max-s
-// over --runs variations, so runs differ ~10x in cost (the dynamic balancing
-// case). Overhead: the same runners on --null-runs variations whose run does
+// Workload: the chapter 3 transient scene (vehicles/data/scenes/ch3_transient.json,
+// the 4WS vehicle at 10 m/s with a steer step) run by the scene runner
+// (runScene, as `vdyn sweep` runs it) with analysis.t_end_s from --t-min-s to
+// --t-max-s over --runs variations, so runs differ ~10x in cost (the dynamic
+// balancing case). Overhead: the same runners on --null-runs variations whose run does
 // nothing, so all that is timed is the runner (scheduling, journal lines,
 // messages). The MPI configurations re-run this program under
 // `mpirun --oversubscribe -n K` (as root it sets OMPI_ALLOW_RUN_AS_ROOT*).
@@ -26,10 +27,10 @@
 #include <map>
 
 #include "bench_util.h"
-#include "ch3_case.h"
 #include "study.h"
-#include "vdyn/core/simulation.h"
+#include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
+#include "vdyn/vehicles/standard_registry.h"
 #ifdef VDYN_HAVE_MPI
 #include "vdyn/core/sweep_mpi.h"
 #endif
@@ -41,30 +42,25 @@ namespace {
 SweepDescription makeSweep(const std::string& workload, int runs, double tMin, double tMax) {
   SweepDescription d;
   d.name = "sweep_scaling_" + workload;
-  d.scene = workload == "ch3" ? "ch3_transient.json" : "(none)";
-  GridAxis ax{{"t_end_s"}, {}};
+  d.scene = workload == "ch3" ? "scenes/ch3_transient.json" : "(none)";
+  GridAxis ax{{"analysis.t_end_s"}, {}};
   for (int i = 0; i < runs; ++i)
     ax.values.push_back({runs == 1 ? tMin : tMin + (tMax - tMin) * double(i) / double(runs - 1)});
   d.addVariations(makeGridVariations({ax}));
-  d.collect = workload == "ch3" ? std::vector<std::string>{"yaw_rate_rad_s", "side_slip_rad", "steps"}
+  d.collect = workload == "ch3" ? std::vector<std::string>{"final.chassis.yaw_rate_rad_s",
+                                                           "final.chassis.side_slip_rad", "run.steps"}
                                 : std::vector<std::string>{"t_end_s"};
   return d;
 }
 
 SweepRunFunction makeRun(const std::string& workload) {
   if (workload == "null")
-    return [](const SweepDescription&, const Variation& v) { return Json{{"t_end_s", *v.find("t_end_s")}}; };
-  const ParamReader data = ParamReader::fromFile("ch3_transient.json");
-  return [data](const SweepDescription&, const Variation& v) {
-    study::Ch3Case ch3 = study::Ch3Case::fromData(data);
-    ch3.sim.t_end_s = v.find("t_end_s")->get<double>();
-    const std::unique_ptr<FourWsVehicle> car = ch3.buildVehicle();
-    SimTK::State s = car->makeInitialState(ch3.speed_m_s);
-    const RunSummary run = simulate(car->getScene(), s, ch3.sim);
-    const Scene& sc = car->getScene();
-    return Json{{"yaw_rate_rad_s", sc.evalOutput("chassis.yaw_rate_rad_s", s)},
-                {"side_slip_rad", sc.evalOutput("chassis.side_slip_rad", s)},
-                {"steps", run.steps}};
+    return [](const SweepDescription&, const Variation& v) { return Json{{"t_end_s", *v.find("analysis.t_end_s")}}; };
+  // The scene is loaded once; each run applies its override and builds anew.
+  const auto scene = std::make_shared<SceneDescription>(
+      SceneDescription::fromFile("scenes/ch3_transient.json", standardRegistry()));
+  return [scene](const SweepDescription&, const Variation& v) {
+    return runScene(scene->withOverrides({Override{"analysis.t_end_s", *v.find("analysis.t_end_s")}}));
   };
 }
 
