@@ -4,6 +4,7 @@
 // (4.23)-(4.44) and a reference (tight central differences with two
 // perturbation sizes that agree); each method's error against the reference
 // and its wall time. --vehicle fourws runs the same on the 4WS vehicle.
+#include "vdyn/core/text.h"
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -15,20 +16,6 @@
 using namespace vdyn;
 
 namespace {
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> v;
-  std::string item;
-  for (char c : s + ",") {
-    if (c == ',') {
-      if (!item.empty()) v.push_back(item);
-      item.clear();
-    } else if (c != ' ') {
-      item += c;
-    }
-  }
-  return v;
-}
-
 std::vector<std::string> stringList(const ParamReader& r, const std::string& key) {
   if (!r.has(key) || !r.json().at(key).is_array()) throw Error(r.at(key) + ": expected an array of names");
   std::vector<std::string> v;

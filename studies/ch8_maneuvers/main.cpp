@@ -7,6 +7,7 @@
 // steering, Kr, lateral velocity, path error: Figures 8.2-8.17), a CSV per
 // run, and summary.json with key "runs". A run that fails is recorded with
 // completed = false and its reason; the study then exits 1 after writing all.
+#include "vdyn/core/text.h"
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -43,15 +44,6 @@ struct RunResult {
   std::string csv;
   Json summary;
 };
-
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream in(s);
-  std::string item;
-  while (std::getline(in, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::string& strategyName,
                  const SimulationSettings& baseSim, const std::string& out) {

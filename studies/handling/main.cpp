@@ -4,6 +4,7 @@
 // speed), ISO 7401 step steer and frequency response (linearisation, checked
 // against sine-steer simulations), FMVSS 126 sine with dwell. CSV per run,
 // PNG plots, summary.json, printed tables and the 2WS/4WS ranking.
+#include "vdyn/core/text.h"
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -19,15 +20,6 @@ using namespace vdyn;
 
 namespace {
 const double kDeg = SimTK::Pi / 180;
-
-std::vector<std::string> splitList(const std::string& s) {
-  std::vector<std::string> out;
-  std::stringstream ss(s);
-  std::string item;
-  while (std::getline(ss, item, ','))
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
 
 struct Config {
   ParamReader data;

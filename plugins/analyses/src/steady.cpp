@@ -2,6 +2,7 @@
 // steady_state (with "stability": true also the eigenvalues), stability,
 // continuation and static_equilibrium. Thin wrappers: settings from one field
 // table, the solver's numbers into the summary.
+#include "vdyn/core/text.h"
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,20 +14,6 @@
 namespace vdyn {
 
 namespace {
-
-std::vector<std::string> splitList(const std::string& list) {
-  std::vector<std::string> out;
-  std::string item;
-  for (std::size_t pos = 0; pos <= list.size(); ++pos) {
-    if (pos == list.size() || list[pos] == ',') {
-      if (!item.empty()) out.push_back(item);
-      item.clear();
-    } else {
-      item += list[pos];
-    }
-  }
-  return out;
-}
 
 /// Settings shared by the steady-state analyses.
 struct SteadySettings {

@@ -1,3 +1,4 @@
+#include "vdyn/core/text.h"
 #include "vdyn/steering/steering.h"
 
 #include <sstream>
@@ -415,19 +416,6 @@ Vec3 parseAxis(const std::string& text, const std::string& where) {
   return a;
 }
 
-std::vector<std::string> splitList(const std::string& list) {
-  std::vector<std::string> out;
-  std::string item;
-  for (std::size_t pos = 0; pos <= list.size(); ++pos) {
-    if (pos == list.size() || list[pos] == ',') {
-      if (!item.empty()) out.push_back(item);
-      item.clear();
-    } else {
-      item += list[pos];
-    }
-  }
-  return out;
-}
 }  // namespace
 
 void registerSteeringPlugins(PluginRegistry& registry) {
