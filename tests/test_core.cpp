@@ -224,3 +224,53 @@ TEST(Simulation, EachRunsCostIntegralStartsAtZero) {
   ASSERT_GT(first, 0.0);
   EXPECT_NEAR(first + second, total, 1e-6 * total);
 }
+
+// --- strict keys (ParamReader::requireAllKeysRead) ---------------------------
+TEST(StrictKeys, UnknownNestedKeyIsNamedWithHint) {
+  const ParamReader r = ParamReader::fromJson(Json::parse(R"({"a": {"stiffness_N_per_m": 1, "stifness_N_per_m": 2}, "b": 3})"),
+                                              "car.json");
+  const ParamReader a = r.child("a");
+  EXPECT_EQ(a.number("stiffness_N_per_m"), 1);
+  r.number("b");
+  const std::string msg = errorOf([&] { r.requireAllKeysRead(); });
+  EXPECT_EQ(msg, "car.json: a.stifness_N_per_m: unknown key (did you mean 'stiffness_N_per_m'?)");
+}
+
+TEST(StrictKeys, AbsentOptionalKeyIsAHint) {
+  const ParamReader r = ParamReader::fromJson(Json::parse(R"({"gravity": 3})"), "q.json");
+  EXPECT_EQ(r.numberOr("gravity_m_per_s2", 9.81), 9.81);
+  EXPECT_EQ(errorOf([&] { r.requireAllKeysRead(); }), "q.json: gravity: unknown key (did you mean 'gravity_m_per_s2'?)");
+}
+
+TEST(StrictKeys, EveryUnknownKeyIsListedAndCommentsPass) {
+  const ParamReader r = ParamReader::fromJson(Json::parse(R"({"x": 1, "y": 2, "_note": "a comment", "k": 0})"), "f");
+  r.number("k");
+  EXPECT_EQ(errorOf([&] { r.requireAllKeysRead(); }), "f: x: unknown key (did you mean 'k'?); f: y: unknown key (did you mean 'k'?)");
+}
+
+TEST(StrictKeys, ArrayElementsAndRawValuesAreChecked) {
+  const ParamReader r = ParamReader::fromJson(
+      Json::parse(R"({"rows": [{"u": 1}, {"u": 2, "v": 3}], "free": {"anything": 1}})"), "t.json");
+  for (const auto& row : r.array("rows")) row.number("u");
+  r.raw("free");  // taken over by the caller
+  EXPECT_EQ(errorOf([&] { r.requireAllKeysRead(); }), "t.json: rows[1].v: unknown key (did you mean 'u'?)");
+}
+
+TEST(StrictKeys, PatchKeysAreNamedAsWritten) {
+  const ParamReader base = ParamReader::fromJson(Json::parse(R"({"spring": {"stiffness_N_per_m": 1}})"), "app.json: corner");
+  const ParamReader variant =
+      ParamReader::fromJson(Json::parse(R"({"over": {"spring": {"stifness_N_per_m": 2}}})"), "v.json");
+  const ParamReader merged = base.mergedWith(variant.child("over"));
+  EXPECT_EQ(merged.child("spring").number("stiffness_N_per_m"), 1);
+  EXPECT_EQ(errorOf([&] { merged.requireAllKeysRead(); }),
+            "v.json: over.spring.stifness_N_per_m: unknown key (did you mean 'stiffness_N_per_m'?)");
+  EXPECT_NO_THROW(variant.requireAllKeysRead());  // the patch counts as read in its own file
+}
+
+TEST(StrictKeys, JsonErrorsNameFileLineAndKey) {
+  EXPECT_EQ(errorOf([] { parseJsonText("{\n \"a\": {\"b\": 1e999}}", "data file 'x.json'"); }),
+            "data file 'x.json' is not valid JSON (line 2, column 13, key a.b): number out of range (not a finite "
+            "double): 1e999");
+  EXPECT_NE(errorOf([] { parseJsonText(R"({"a": 1, "a": 2})", "f"); }).find("duplicate key 'a'"), std::string::npos);
+  EXPECT_EQ(errorOf([] { parseJsonText("  \n", "f"); }), "f is empty (expected a JSON object)");
+}

@@ -28,7 +28,12 @@ IntegratorSettings IntegratorSettings::fromParams(const ParamReader& r, Integrat
   d.accuracy = r.numberOr("accuracy", d.accuracy);
   d.constraint_tolerance = r.numberOr("constraint_tolerance", d.constraint_tolerance);
   d.max_step_s = r.numberOr("max_step_s", d.max_step_s);
-  d.validate();
+  r.requireAllKeysRead();
+  try {
+    d.validate();
+  } catch (const Error& e) {
+    throw Error(r.where() + " " + e.what());
+  }
   return d;
 }
 

@@ -1,22 +1,144 @@
 #include "vdyn/core/params.h"
 
 #include <algorithm>
+#include <climits>
 #include <cstdlib>
 #include <fstream>
+#include <functional>
+#include <map>
+#include <mutex>
+#include <set>
+#include <sstream>
 
 #include <dlfcn.h>
 #include <sys/stat.h>
 
 namespace vdyn {
 
-Json readJsonFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw Error("cannot open data file '" + path + "'");
-  try {
-    return Json::parse(in, nullptr, true, /*ignore_comments=*/true);
-  } catch (const nlohmann::json::parse_error& e) {
-    throw Error("data file '" + path + "' is not valid JSON: " + e.what());
+namespace {
+/// A SAX pass that only follows the key path, so a syntax error, a number out
+/// of range (1e999) or a duplicate key can be reported with where it is.
+class PathSax : public nlohmann::json_sax<Json> {
+ public:
+  std::string error;       ///< empty when the text parsed
+  std::size_t position = 0;
+  std::string path() const {
+    std::string p;
+    for (const Frame& f : frames_) {
+      if (f.obj) {
+        if (!f.key.empty() || f.keys.size()) p += (p.empty() ? "" : ".") + f.key;
+      } else if (f.index >= 0) {
+        p += "[" + std::to_string(f.index) + "]";
+      }
+    }
+    return p;
   }
+  bool null() override { return value(); }
+  bool boolean(bool) override { return value(); }
+  bool number_integer(number_integer_t) override { return value(); }
+  bool number_unsigned(number_unsigned_t) override { return value(); }
+  bool number_float(number_float_t, const string_t&) override { return value(); }
+  bool string(string_t&) override { return value(); }
+  bool binary(binary_t&) override { return value(); }
+  bool start_object(std::size_t) override {
+    value();
+    frames_.push_back({true, {}, "", -1});
+    return true;
+  }
+  bool key(string_t& k) override {
+    Frame& f = frames_.back();
+    f.key = k;
+    if (!f.keys.insert(k).second) {
+      error = "duplicate key '" + k + "' (the second would silently replace the first)";
+      return false;
+    }
+    return true;
+  }
+  bool end_object() override {
+    frames_.pop_back();
+    return true;
+  }
+  bool start_array(std::size_t) override {
+    value();
+    frames_.push_back({false, {}, "", -1});
+    return true;
+  }
+  bool end_array() override {
+    frames_.pop_back();
+    return true;
+  }
+  bool parse_error(std::size_t pos, const std::string& token, const nlohmann::detail::exception& ex) override {
+    // pos is just past the offending token: point at its first character.
+    position = pos >= token.size() ? pos - token.size() + 1 : pos;
+    std::string what = ex.what();
+    // "[json.exception.parse_error.101] parse error at line 1, column 2: syntax error ..." -> the reason
+    const auto colon = what.find(": ", what.find(']'));
+    if (ex.id == 406) what = "number out of range (not a finite double): " + token;
+    else if (colon != std::string::npos) what = what.substr(colon + 2);
+    error = what;
+    return false;
+  }
+
+ private:
+  struct Frame {
+    bool obj;
+    std::set<std::string> keys;
+    std::string key;
+    long index;
+  };
+  bool value() {
+    if (!frames_.empty() && !frames_.back().obj) ++frames_.back().index;
+    return true;
+  }
+  std::vector<Frame> frames_;
+};
+
+std::string lineColumn(const std::string& text, std::size_t pos) {
+  pos = std::min(pos, text.size());
+  std::size_t line = 1, col = 1;
+  for (std::size_t i = 0; i + 1 < pos; ++i) {
+    if (text[i] == '\n') {
+      ++line;
+      col = 1;
+    } else {
+      ++col;
+    }
+  }
+  return "line " + std::to_string(line) + ", column " + std::to_string(col);
+}
+}  // namespace
+
+Json parseJsonText(const std::string& text, const std::string& name) {
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error(name + " is empty (expected a JSON object)");
+  PathSax sax;
+  bool ok = false;
+  try {
+    ok = Json::sax_parse(text, &sax, Json::input_format_t::json, /*strict=*/true, /*ignore_comments=*/true);
+  } catch (const std::exception& e) {
+    sax.error = e.what();
+  }
+  if (!ok || !sax.error.empty()) {
+    const std::string path = sax.path();
+    throw Error(name + " is not valid JSON (" + lineColumn(text, sax.position) +
+                (path.empty() ? "" : ", key " + path) + "): " + (sax.error.empty() ? "parse error" : sax.error));
+  }
+  try {
+    return Json::parse(text, nullptr, true, /*ignore_comments=*/true);
+  } catch (const nlohmann::json::exception& e) {
+    throw Error(name + " is not valid JSON: " + e.what());
+  }
+}
+
+Json readJsonFile(const std::string& path) {
+  struct stat st;
+  if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw Error("data file '" + path + "' is a folder, not a JSON file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw Error("cannot open data file '" + path + "'");
+  std::ostringstream text;
+  text << in.rdbuf();
+  if (in.bad()) throw Error("cannot read data file '" + path + "'");
+  return parseJsonText(text.str(), "data file '" + path + "'");
 }
 
 std::vector<std::string> dataSearchPath() {
@@ -67,12 +189,6 @@ static bool fileExists(const std::string& p) {
   return stat(p.c_str(), &st) == 0 && S_ISREG(st.st_mode);
 }
 
-static std::string joinFolders(const std::vector<std::string>& folders) {
-  std::string s;
-  for (const auto& f : folders) s += (s.empty() ? "" : ", ") + f;
-  return s;
-}
-
 std::string resolveDataPath(const std::string& name, const std::string& namingFile) {
   if (!name.empty() && name[0] == '/') {
     if (fileExists(name)) return name;
@@ -81,28 +197,70 @@ std::string resolveDataPath(const std::string& name, const std::string& namingFi
   const auto slash = namingFile.find_last_of('/');
   const std::string here = slash == std::string::npos ? "." : namingFile.substr(0, slash);
   if (fileExists(here + "/" + name)) return here == "." ? name : here + "/" + name;
-  for (const auto& dir : dataSearchPath())
+  std::string looked = here;
+  for (const auto& dir : dataSearchPath()) {
     if (fileExists(dir + "/" + name)) return dir + "/" + name;
-  throw Error(namingFile + ": data file '" + name + "' not found (looked in " + here + ", " +
-              joinFolders(dataSearchPath()) + ")");
+    looked += ", " + dir;
+  }
+  throw Error(namingFile + ": data file '" + name + "' not found (looked in " + looked + ")");
 }
 
+struct ParamReader::Tracker {
+  std::mutex mutex;
+  std::map<const Json*, std::set<std::string>> queried;  ///< keys asked for, per object node
+  std::set<const Json*> opened;                          ///< nodes opened as readers (checked recursively)
+  std::set<const Json*> consumed;                        ///< nodes taken over by raw() or mergedWith()
+  std::shared_ptr<ParamReader> patch;                    ///< mergedWith(): the patch, checked first
+  std::string baseWhere;                                 ///< mergedWith(): where the base came from
+};
+
 ParamReader::ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where)
-    : root_(std::move(root)), node_(node), where_(std::move(where)) {
-  if (!node_->is_object()) throw Error(where_ + ": expected an object");
+    : ParamReader(std::move(root), node, std::move(where), std::make_shared<Tracker>()) {}
+
+ParamReader::ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where,
+                         std::shared_ptr<Tracker> tracker)
+    : root_(std::move(root)), tracker_(std::move(tracker)), node_(node), where_(std::move(where)) {
+  if (!node_->is_object()) {
+    std::string w = where_;
+    if (!w.empty() && w.back() == ':') w.pop_back();
+    throw Error(w + ": expected an object, got " + std::string(node_->type_name()));
+  }
+  std::lock_guard<std::mutex> lock(tracker_->mutex);
+  tracker_->opened.insert(node_);
+}
+
+void ParamReader::mark(const std::string& key) const {
+  std::lock_guard<std::mutex> lock(tracker_->mutex);
+  tracker_->queried[node_].insert(key);
 }
 
 namespace {
+std::string baseName(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
+
 /// Reads a data file; a file with "based_on": "<other file>" is that file with
 /// its own keys merged over it (RFC 7396 merge patch), so a variant names only
-/// what it changes. Chains are followed (at most 8 deep).
-Json readWithBase(const std::string& resolved, int depth) {
+/// what it changes. Chains are followed (at most 8 deep); a cycle is an error.
+Json readWithBase(const std::string& resolved, std::vector<std::string>& chain) {
   Json j = readJsonFile(resolved);
-  if (!j.is_object() || !j.contains("based_on")) return j;
-  const std::string name = resolved.substr(resolved.find_last_of('/') + 1);
-  if (!j["based_on"].is_string()) throw Error(name + ": based_on: expected a data file name");
-  if (depth >= 8) throw Error(name + ": based_on: chain deeper than 8 files (a cycle?)");
-  Json base = readWithBase(resolveDataPath(j["based_on"].get<std::string>(), resolved), depth + 1);
+  const std::string name = baseName(resolved);
+  if (!j.is_object())
+    throw Error(name + ": expected a JSON object at the top level, got " + std::string(j.type_name()));
+  if (!j.contains("based_on")) return j;
+  if (!j["based_on"].is_string())
+    throw Error(name + ": based_on: expected a data file name, got " + j["based_on"].dump());
+  chain.push_back(resolved);
+  const std::string next = resolveDataPath(j["based_on"].get<std::string>(), resolved);
+  for (const auto& c : chain) {
+    char a[PATH_MAX], b[PATH_MAX];
+    const bool same = (realpath(c.c_str(), a) && realpath(next.c_str(), b)) ? std::string(a) == b : c == next;
+    if (same) {
+      std::string cycle;
+      for (const auto& k : chain) cycle += baseName(k) + " -> ";
+      throw Error(name + ": based_on: the variants form a cycle: " + cycle + baseName(next));
+    }
+  }
+  if (chain.size() >= 8) throw Error(name + ": based_on: chain deeper than 8 files");
+  Json base = readWithBase(next, chain);
   j.erase("based_on");
   base.merge_patch(j);
   return base;
@@ -111,9 +269,9 @@ Json readWithBase(const std::string& resolved, int depth) {
 
 ParamReader ParamReader::fromFile(const std::string& path) {
   const std::string resolved = resolveDataPath(path);
-  auto root = std::make_shared<const Json>(readWithBase(resolved, 0));
-  const std::string base = resolved.substr(resolved.find_last_of('/') + 1);
-  return ParamReader(root, root.get(), base + ":");
+  std::vector<std::string> chain;
+  auto root = std::make_shared<const Json>(readWithBase(resolved, chain));
+  return ParamReader(root, root.get(), baseName(resolved) + ":");
 }
 
 ParamReader ParamReader::fromJson(Json j, std::string where) {
@@ -126,15 +284,13 @@ std::string ParamReader::at(const std::string& key) const {
   return where_ + "." + key;
 }
 
-void ParamReader::note(const std::string& key) const { record_->asked.insert({node_, key}); }
-
 bool ParamReader::has(const std::string& key) const {
-  note(key);
+  mark(key);
   return node_->contains(key);
 }
 
 const Json& ParamReader::require(const std::string& key) const {
-  note(key);
+  mark(key);
   auto it = node_->find(key);
   if (it == node_->end()) throw Error(at(key) + ": missing key");
   return *it;
@@ -201,96 +357,151 @@ int ParamReader::integer(const std::string& key) const {
 ParamReader ParamReader::child(const std::string& key) const {
   const Json& v = require(key);
   if (!v.is_object()) throw Error(at(key) + ": expected an object, got " + v.dump());
-  ParamReader c(root_, &v, at(key));
-  c.record_ = record_;
-  record_->visited.insert(&v);
-  return c;
+  return ParamReader(root_, &v, at(key), tracker_);
 }
 
 std::vector<ParamReader> ParamReader::array(const std::string& key) const {
   const Json& v = require(key);
   if (!v.is_array()) throw Error(at(key) + ": expected an array, got " + v.dump());
   std::vector<ParamReader> out;
-  for (std::size_t i = 0; i < v.size(); ++i) {
-    out.emplace_back(root_, &v[i], at(key) + "[" + std::to_string(i) + "]");
-    out.back().record_ = record_;
-    record_->visited.insert(&v[i]);
-  }
+  for (std::size_t i = 0; i < v.size(); ++i)
+    out.push_back(ParamReader(root_, &v[i], at(key) + "[" + std::to_string(i) + "]", tracker_));
   return out;
+}
+
+const Json& ParamReader::raw(const std::string& key) const {
+  const Json& v = require(key);
+  std::lock_guard<std::mutex> lock(tracker_->mutex);
+  tracker_->consumed.insert(&v);
+  return v;
 }
 
 namespace {
 std::size_t editDistance(const std::string& a, const std::string& b) {
-  std::vector<std::size_t> row(b.size() + 1);
-  for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+  std::vector<std::size_t> d(b.size() + 1);
+  for (std::size_t j = 0; j <= b.size(); ++j) d[j] = j;
   for (std::size_t i = 1; i <= a.size(); ++i) {
-    std::size_t diag = row[0];
-    row[0] = i;
+    std::size_t prev = d[0];
+    d[0] = i;
     for (std::size_t j = 1; j <= b.size(); ++j) {
-      const std::size_t up = row[j];
-      row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] == b[j - 1] ? 0 : 1)});
-      diag = up;
+      const std::size_t cur = d[j];
+      d[j] = std::min({d[j] + 1, d[j - 1] + 1, prev + (a[i - 1] == b[j - 1] ? 0 : 1)});
+      prev = cur;
     }
   }
-  return row[b.size()];
+  return d[b.size()];
+}
+
+/// The candidate closest to `key`: edit distance, less twice the common prefix
+/// (so "gravity" finds "gravity_m_per_s2", a key without its unit); empty when
+/// even the closest is too far to be a plausible misspelling.
+std::string nearest(const std::string& key, const std::set<std::string>& candidates) {
+  std::string best;
+  long bestD = 0;
+  for (const auto& c : candidates) {
+    std::size_t prefix = 0;
+    while (prefix < key.size() && prefix < c.size() && key[prefix] == c[prefix]) ++prefix;
+    const long dist = long(editDistance(key, c)) - 2 * long(prefix);
+    if (best.empty() || dist < bestD) {
+      bestD = dist;
+      best = c;
+    }
+  }
+  return bestD <= std::max<long>(2, long(key.size()) / 3) ? best : std::string();
+}
+
+std::string unknownKey(const std::string& path, const std::string& key, const std::set<std::string>& asked) {
+  const std::string hint = nearest(key, asked);
+  return path + ": unknown key" + (hint.empty() ? "" : " (did you mean '" + hint + "'?)");
+}
+
+std::string join(const std::string& where, const std::string& path) {
+  if (!where.empty() && where.back() == ':') return where + " " + path;
+  return where + "." + path;
 }
 }  // namespace
 
-void ParamReader::collectUnread(const Json& node, const std::string& where, std::vector<std::string>& out) const {
-  auto loc = [&](const std::string& key) {
-    return (!where.empty() && where.back() == ':') ? where + " " + key : where + "." + key;
-  };
-  for (auto it = node.begin(); it != node.end(); ++it) {
-    const std::string& key = it.key();
-    if (!key.empty() && key[0] == '_') continue;
-    if (!record_->asked.count({&node, key})) {
-      std::string hint, best;
-      std::size_t bestD = std::string::npos;
-      for (const auto& [n, k] : record_->asked)
-        if (n == &node && k != key) {
-          const std::size_t d = editDistance(key, k);
-          if (d < bestD) bestD = d, best = k;
-        }
-      if (!best.empty() && bestD <= std::max<std::size_t>(2, key.size() / 3)) hint = " (did you mean '" + best + "'?)";
-      out.push_back(loc(key) + ": unknown key" + hint);
-      continue;
-    }
-    const Json& v = it.value();
-    if (v.is_object() && record_->visited.count(&v)) collectUnread(v, loc(key), out);
-    if (v.is_array())
-      for (std::size_t i = 0; i < v.size(); ++i)
-        if (v[i].is_object() && record_->visited.count(&v[i]))
-          collectUnread(v[i], loc(key) + "[" + std::to_string(i) + "]", out);
-  }
-}
-
 std::vector<std::string> ParamReader::unreadKeys() const {
-  std::vector<std::string> out;
-  collectUnread(*node_, where_, out);
-  return out;
+  std::vector<std::string> problems;
+  std::lock_guard<std::mutex> lock(tracker_->mutex);
+  const Tracker& t = *tracker_;
+  const std::function<void(const Json&, const std::string&)> walk = [&](const Json& node, const std::string& w) {
+    if (t.consumed.count(&node)) return;
+    if (node.is_array()) {
+      for (std::size_t i = 0; i < node.size(); ++i) walk(node[i], w + "[" + std::to_string(i) + "]");
+      return;
+    }
+    if (!node.is_object() || !t.opened.count(&node)) return;
+    static const std::set<std::string> none;
+    const auto q = t.queried.find(&node);
+    const std::set<std::string>& asked = q == t.queried.end() ? none : q->second;
+    for (auto it = node.begin(); it != node.end(); ++it) {
+      if (!it.key().empty() && it.key()[0] == '_') continue;  // comment key
+      const std::string path = join(w, it.key());
+      if (!asked.count(it.key())) {
+        problems.push_back(unknownKey(path, it.key(), asked));
+        continue;
+      }
+      walk(*it, path);
+    }
+  };
+  if (t.patch && node_ == root_.get()) {
+    // Keys of the patch the merged reader never asked for, named as the user wrote them.
+    const std::function<void(const Json&, const Json&, const std::string&)> walkPatch =
+        [&](const Json& patch, const Json& merged, const std::string& w) {
+          if (!patch.is_object() || !merged.is_object() || t.consumed.count(&merged)) return;
+          static const std::set<std::string> none;
+          const auto q = t.queried.find(&merged);
+          const std::set<std::string>& asked = q == t.queried.end() ? none : q->second;
+          for (auto it = patch.begin(); it != patch.end(); ++it) {
+            if (!it.key().empty() && it.key()[0] == '_') continue;
+            const std::string path = join(w, it.key());
+            if (!asked.count(it.key())) {
+              problems.push_back(unknownKey(path, it.key(), asked));
+              continue;
+            }
+            const auto m = merged.find(it.key());
+            if (m != merged.end() && t.opened.count(&*m)) walkPatch(*it, *m, path);
+          }
+        };
+    walkPatch(t.patch->json(), *node_, t.patch->where());
+  }
+  if (problems.empty()) walk(*node_, t.patch && node_ == root_.get() && !t.baseWhere.empty() ? t.baseWhere : where_);
+  return problems;
 }
 
 void ParamReader::requireAllKeysRead() const {
-  const auto unread = unreadKeys();
-  if (unread.empty()) return;
+  const std::vector<std::string> problems = unreadKeys();
+  if (problems.empty()) return;
   std::string msg;
-  for (const auto& u : unread) msg += (msg.empty() ? "" : "\n") + u;
+  for (const auto& p : problems) msg += (msg.empty() ? "" : "; ") + p;
   throw Error(msg);
 }
 
 void ParamReader::markAllRead() const {
-  std::function<void(const Json&)> mark = [&](const Json& n) {
-    if (n.is_object()) {
-      record_->visited.insert(&n);
-      for (auto it = n.begin(); it != n.end(); ++it) {
-        record_->asked.insert({&n, it.key()});
-        mark(it.value());
-      }
-    } else if (n.is_array()) {
-      for (const auto& e : n) mark(e);
-    }
-  };
-  mark(*node_);
+  std::lock_guard<std::mutex> lock(tracker_->mutex);
+  tracker_->consumed.insert(node_);
+}
+
+ParamReader ParamReader::mergedWith(const ParamReader& patch) const {
+  Json m = *node_;
+  m.merge_patch(*patch.node_);
+  {
+    std::lock_guard<std::mutex> lock(tracker_->mutex);
+    tracker_->consumed.insert(node_);
+  }
+  {
+    std::lock_guard<std::mutex> lock(patch.tracker_->mutex);
+    patch.tracker_->consumed.insert(patch.node_);
+  }
+  auto root = std::make_shared<const Json>(std::move(m));
+  auto tracker = std::make_shared<Tracker>();
+  tracker->patch = std::make_shared<ParamReader>(patch);
+  // Named by the patch (what the user wrote); its requireAllKeysRead names an
+  // unknown key of the base by the base's own location.
+  ParamReader merged(root, root.get(), patch.where_, tracker);
+  tracker->baseWhere = where_;
+  return merged;
 }
 
 }  // namespace vdyn

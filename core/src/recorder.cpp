@@ -1,7 +1,7 @@
 #include "vdyn/core/recorder.h"
 
 #include <cstdio>
-#include <fstream>
+#include "vdyn/core/file_io.h"
 
 namespace vdyn {
 
@@ -72,21 +72,22 @@ const std::vector<double>& Recorder::column(const std::string& name) const {
 }
 
 void Recorder::writeCsv(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write '" + path + "'");
-  out << "t_s";
-  for (const auto& n : names_) out << ',' << n;
-  out << '\n';
+  // Built in memory and written atomically: the CSV is complete or absent.
+  std::string out = "t_s";
+  for (const auto& n : names_) out += ',' + n;
+  out += '\n';
+  out.reserve(out.size() + time_.size() * (12 + 20 * columns_.size()));
   char buf[32];
   for (std::size_t r = 0; r < time_.size(); ++r) {
     std::snprintf(buf, sizeof buf, "%.9g", time_[r]);
-    out << buf;
+    out += buf;
     for (const auto& c : columns_) {
-      std::snprintf(buf, sizeof buf, "%.12g", c[r]);
-      out << ',' << buf;
+      std::snprintf(buf, sizeof buf, ",%.12g", c[r]);
+      out += buf;
     }
-    out << '\n';
+    out += '\n';
   }
+  writeFileAtomic(path, out);
 }
 
 void Recorder::clear() {

@@ -1,5 +1,6 @@
 #include "vdyn/core/scene_file.h"
 
+#include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -37,9 +38,18 @@ Override Override::parse(const std::string& text, const std::string& option) {
   Override o;
   o.key_path = text.substr(0, eq);
   const std::string v = text.substr(eq + 1);
+  // nan, inf and numbers beyond a double are named here: silently turned into
+  // a string (or the JSON library's raw text) they would name nothing.
+  std::string lower;
+  for (char c : v) lower += char(std::tolower(static_cast<unsigned char>(c)));
+  const std::string bare = (!lower.empty() && (lower[0] == '-' || lower[0] == '+')) ? lower.substr(1) : lower;
+  if (bare == "nan" || bare == "inf" || bare == "infinity")
+    throw Error(option + " '" + text + "': " + v + " is not a finite number");
   try {
     o.value = Json::parse(v);
-  } catch (const Json::parse_error&) {
+  } catch (const Json::out_of_range&) {
+    throw Error(option + " '" + text + "': number out of range (not a finite double): " + v);
+  } catch (const Json::exception&) {
     o.value = v;  // a bare word: a string
   }
   return o;
@@ -227,13 +237,17 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
       haveVehicle = attempt(v->where(), v.get(), [&] {
         const std::string type = v->string("type");
         b.initial_speed_m_s = v->numberOr("initial_speed_m_s", 0.0);
+        if (!(b.initial_speed_m_s >= 0 && b.initial_speed_m_s <= 100))
+          throw Error(v->at("initial_speed_m_s") + " must lie in [0, 100] m/s, got " + formatValue(b.initial_speed_m_s));
         const std::string dataFile = resolveDataPath(v->string("data"), file);
-        Json data = ParamReader::fromFile(dataFile).json();
-        if (v->has("overrides")) data.merge_patch(v->child("overrides").json());
-        const std::string dataName = dataFile.substr(dataFile.find_last_of('/') + 1);
-        const VehicleSpec spec{type, ParamReader::fromJson(std::move(data), dataName), registry_};
+        // The overrides merged over the data file: a key the vehicle's loader
+        // never asks for is named by the scene's own key path
+        // (vehicle.overrides...) when the user wrote it there, else by the data file's.
+        ParamReader data = ParamReader::fromFile(dataFile);
+        if (v->has("overrides")) data = data.mergedWith(v->child("overrides"));
+        const VehicleSpec spec{type, data, registry_};
         b.vehicle = registry_->createVehicle(type, spec, v->at("type"));
-        if (v->has("overrides")) v->child("overrides").markAllRead();  // read by the vehicle's own loader
+        data.requireAllKeysRead();
       });
   }
 

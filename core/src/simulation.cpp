@@ -2,13 +2,55 @@
 
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 
 namespace vdyn {
 
 void SimulationSettings::validate() const {
   requireFinite(t_end_s, "simulation t_end_s");
   requireNonNegative(report_interval_s, "simulation report_interval_s");
+  if (max_steps < 0) throw Error("simulation max_steps must not be negative, got " + std::to_string(max_steps));
+  requireNonNegative(min_step_s, "simulation min_step_s");
+  if (min_step_count < 1)
+    throw Error("simulation min_step_count must be at least 1, got " + std::to_string(min_step_count));
+  requireNonNegative(wall_time_budget_s, "simulation wall_time_budget_s");
+  if (max_samples < 1) throw Error("simulation max_samples must be at least 1, got " + std::to_string(max_samples));
+  requireNonNegative(progress_interval_s, "simulation progress_interval_s");
   integrator.validate();
+}
+
+std::string stateSummary(const Scene& scene, const SimTK::State& state) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, "t = %.9g s", state.getTime());
+  std::string out = buf;
+  bool any = false;
+  for (const char* name : {"chassis.x_m", "chassis.y_m", "chassis.z_m", "chassis.forward_speed_m_s",
+                           "chassis.yaw_rate_rad_s", "chassis.side_slip_rad"}) {
+    if (!scene.hasOutput(name)) continue;
+    try {
+      std::snprintf(buf, sizeof buf, ", %s = %.6g", name, scene.evalOutput(name, state));
+      out += buf;
+      any = true;
+    } catch (const std::exception&) {
+    }
+  }
+  if (!any && state.getSystemStage() >= SimTK::Stage::Model) {
+    auto largest = [](const SimTK::Vector& v, int& at) {
+      double m = 0;
+      at = -1;
+      for (int i = 0; i < v.size(); ++i)
+        if (!(std::abs(v[i]) <= m)) {
+          m = std::abs(v[i]);
+          at = i;
+        }
+      return m;
+    };
+    int iq = -1, iu = -1;
+    const double q = largest(state.getQ(), iq), u = largest(state.getU(), iu);
+    std::snprintf(buf, sizeof buf, ", max |q| = %.6g (q[%d]), max |u| = %.6g (u[%d])", q, iq, u, iu);
+    out += buf;
+  }
+  return out;
 }
 
 double positionConstraintError(const SimTK::State& state) {
@@ -42,6 +84,10 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   sum.max_constraint_error = positionConstraintError(integ->getState());
 
   const bool reporting = recorder && s.report_interval_s > 0;
+  if (reporting && (s.t_end_s - t0) / s.report_interval_s > double(s.max_samples))
+    throw Error("simulate: report_interval_s = " + formatValue(s.report_interval_s) + " s gives " +
+                formatValue(std::ceil((s.t_end_s - t0) / s.report_interval_s)) + " samples over " +
+                formatValue(s.t_end_s - t0) + " s, more than max_samples = " + std::to_string(s.max_samples));
   long k = 1;  // index of the next report time t0 + k * dt (no accumulated drift)
   auto nextReport = [&] { return std::min(s.t_end_s, t0 + k * s.report_interval_s); };
   if (reporting) recorder->record(integ->getState());
@@ -91,6 +137,17 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   // EndOfSimulation (simbody issue #824, fixed after 3.7), so the loop also ends
   // when the integrator's time reaches t_end.
   const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
+  // Run guards (SimulationSettings): each ends the run with an Error that says where.
+  int smallSteps = 0;
+  auto lastProgress = wall0;
+  auto stopped = [&](const std::string& guard) {
+    const SimTK::State& at = integ->getState();
+    return Error("simulate: " + s.integrator.method + " at accuracy " + formatValue(s.integrator.accuracy) + ": " +
+                 guard + "; stopped at " + stateSummary(scene, at) + " after " +
+                 std::to_string(integ->getNumStepsTaken()) + " steps (last step " +
+                 formatValue(integ->getPreviousStepSizeTaken()) + " s) of the run to t_end " + formatValue(s.t_end_s) +
+                 " s");
+  };
   for (;;) {
     SimTK::Integrator::SuccessfulStepStatus status;
     try {
@@ -105,6 +162,23 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       const SimTK::State& adv = integ->getAdvancedState();
       sum.max_constraint_error = std::max(sum.max_constraint_error, positionConstraintError(adv));
       if (afterStep) afterStep(adv);
+      if (s.max_steps > 0 && integ->getNumStepsAttempted() >= s.max_steps)
+        throw stopped("step limit max_steps = " + std::to_string(s.max_steps) + " reached");
+      const double h = integ->getPreviousStepSizeTaken();
+      smallSteps = (s.min_step_s > 0 && h < s.min_step_s && adv.getTime() < s.t_end_s - tEndTol) ? smallSteps + 1 : 0;
+      if (smallSteps >= s.min_step_count)
+        throw stopped("step size collapsed: " + std::to_string(smallSteps) + " steps in a row shorter than min_step_s = " +
+                      formatValue(s.min_step_s) + " s");
+      if (s.wall_time_budget_s > 0 || s.progress) {
+        const auto now = std::chrono::steady_clock::now();
+        const double wall = std::chrono::duration<double>(now - wall0).count();
+        if (s.wall_time_budget_s > 0 && wall > s.wall_time_budget_s)
+          throw stopped("wall-clock budget wall_time_budget_s = " + formatValue(s.wall_time_budget_s) + " s used up");
+        if (s.progress && std::chrono::duration<double>(now - lastProgress).count() >= s.progress_interval_s) {
+          lastProgress = now;
+          s.progress(adv, wall);
+        }
+      }
     } else if (status == S::ReachedReportTime) {
       if (reporting && !ownInterpolation) {
         recorder->record(integ->getState());

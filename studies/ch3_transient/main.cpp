@@ -7,6 +7,7 @@
 
 #include "ch3_case.h"
 #include "study.h"
+#include "vdyn/core/events.h"
 #include "vdyn/core/simulation.h"
 
 using namespace vdyn;
@@ -30,7 +31,30 @@ int main(int argc, char** argv) {
     // The scene's composition and run, exactly as `vdyn run` makes them
     // (analyses/runTransient): the scene records the columns below.
     BuiltScene built = ch3.build();
-    const TransientRun tr = runTransient(built, ch3.transient, study::progress);
+    // Physical events (spin-out and rollover end the run) and, at the end, the
+    // steady verdict: the final values are the steady turn's only if the run
+    // ended steady; otherwise no radius is reported and the study exits 1.
+    EventMonitor events(built.scene());
+    TransientRun tr;
+    try {
+      tr = runTransient(built, ch3.transient, [&](const std::string& label, double tEnd) {
+        return events.callback(study::progress(label, tEnd));
+      });
+    } catch (const RunStopped& e) {
+      study::endProgress();
+      study::writeJson(out + "/summary.json", {{"completed", false},
+                                               {"steady", false},
+                                               {"reason", e.what()},
+                                               {"events", events.toJson()},
+                                               {"speed_m_s", U0},
+                                               {"front_rad", front},
+                                               {"rear_rad", rear},
+                                               {"event_limits",
+                                                {{"spin_out_side_slip_rad", events.limits().spin_out_side_slip_rad},
+                                                 {"rollover_roll_rad", events.limits().rollover_roll_rad}}}});
+      for (const auto& ev : events.events()) std::printf("ch3_transient: event: %s\n", ev.describe().c_str());
+      throw Error(std::string("the vehicle left its regime: ") + e.what() + " (no steady values reported)");
+    }
     study::endProgress();
     const Recorder& rec = *tr.recorder;
     const RunSummary& run = tr.run;
@@ -40,6 +64,16 @@ int main(int argc, char** argv) {
     const double assemblyMove = tr.vehicle.at("assembly_max_body_move_m").get<double>();
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
+    const double steadyWindow = 2.0, steadyRel = 1e-3, steadyAbs = 1e-5;
+    study::SteadyVerdict verdict =
+        study::checkSteady(rec.time(), rec.column("chassis.yaw_rate_rad_s"), "yaw rate (rad/s)", ch3.settledTime(),
+                           steadyWindow, steadyRel, steadyAbs);
+    if (verdict.steady) {
+      const study::SteadyVerdict slip = study::checkSteady(rec.time(), rec.column("chassis.side_slip_rad"),
+                                                           "side slip (rad)", ch3.settledTime(), steadyWindow,
+                                                           steadyRel, steadyAbs);
+      if (!slip.steady) verdict = slip;
+    }
 
     double steerError = 0;  // largest |angle - command| over the samples, both axles
     for (const char* axle : {"front_steer", "rear_steer"}) {
@@ -50,14 +84,21 @@ int main(int argc, char** argv) {
     const Scene& sc = built.scene();
     auto fin = [&](const std::string& n) { return sc.evalOutput(n, s); };
     const double r = fin("chassis.yaw_rate_rad_s");
-    Json summary = {{"yaw_rate_rad_s", r},
+    Json summary = {{"completed", true},
+                    {"steady", verdict.steady},
+                    {"steady_check", {{"window_s", steadyWindow},
+                                      {"relative_tolerance", steadyRel},
+                                      {"absolute_tolerance", steadyAbs},
+                                      {"verdict", verdict.toJson()}}},
+                    {"events", events.toJson()},
+                    {"yaw_rate_rad_s", r},
                     {"roll_rate_rad_s", fin("chassis.roll_rate_rad_s")},
                     {"pitch_rate_rad_s", fin("chassis.pitch_rate_rad_s")},
                     {"roll_rad", fin("chassis.roll_rad")},
                     {"pitch_rad", fin("chassis.pitch_rad")},
                     {"chassis_z_m", fin("chassis.z_m")},
                     {"wheel_spin_rad_s", {fin("rf.spin_rad_s"), fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s")}},
-                    {"path_radius_m", U0 / r},
+                    {"path_radius_m", verdict.steady ? Json(U0 / r) : Json(nullptr)},
                     {"side_slip_rad", fin("chassis.side_slip_rad")},
                     {"speed_hold_force_N", fin("speed_hold.force_N")},
                     {"dof", dof},
@@ -89,7 +130,11 @@ int main(int argc, char** argv) {
     }
     std::printf("ch3_transient: U0 = %g m/s, front %.3f deg, rear %.3f deg, %s at %g, T = %g s\n", U0, front / deg,
                 rear / deg, run.integrator.c_str(), run.accuracy, sim.t_end_s);
-    std::printf("  yaw rate            %.6f rad/s (path radius %.3f m)\n", r, U0 / r);
+    if (verdict.steady)
+      std::printf("  yaw rate            %.6f rad/s (path radius %.3f m), steady\n", r, U0 / r);
+    else
+      std::printf("  yaw rate at the end %.6f rad/s: NOT steady (%s)\n", r, verdict.reason.c_str());
+    for (const auto& e : events.events()) std::printf("  event: %s\n", e.describe().c_str());
     std::printf("  roll / pitch        %.6f / %.6f rad (rates %.2e / %.2e rad/s)\n", fin("chassis.roll_rad"),
                 fin("chassis.pitch_rad"), fin("chassis.roll_rate_rad_s"), fin("chassis.pitch_rate_rad_s"));
     std::printf("  chassis height      %.6f m; side slip %.6f rad; speed-hold force %.2f N\n", fin("chassis.z_m"),
@@ -102,5 +147,7 @@ int main(int argc, char** argv) {
                 tr.vehicle.at("corner_model").get<std::string>().c_str());
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
+    if (!verdict.steady)
+      throw Error("no steady turn: " + verdict.reason + " (summary.json: steady false; no path radius reported)");
   });
 }

@@ -19,7 +19,7 @@ namespace {
 std::vector<std::string> stringList(const ParamReader& r, const std::string& key) {
   if (!r.has(key) || !r.json().at(key).is_array()) throw Error(r.at(key) + ": expected an array of names");
   std::vector<std::string> v;
-  for (const auto& e : r.json().at(key)) {
+  for (const auto& e : r.raw(key)) {
     if (!e.is_string()) throw Error(r.at(key) + ": expected names (strings), got " + e.dump());
     v.push_back(e.get<std::string>());
   }
@@ -80,6 +80,7 @@ int main(int argc, char** argv) {
       prob.parameters = stringList(data, "design_parameters");
       prob.cost = costOf(data.child("cost"));
       prob.t_end_s = data.number("t_end_s");
+      data.has("fourws");  // the --vehicle fourws case: not read here, not unknown
     } else if (vehicle == "fourws") {
       const ParamReader f = data.child("fourws");
       const ParamReader man = ParamReader::fromFile(f.string("manoeuvre"));
@@ -93,6 +94,8 @@ int main(int argc, char** argv) {
       prob.parameters = stringList(f, "design_parameters");
       prob.cost = costOf(f.child("cost"));
       prob.t_end_s = f.number("t_end_s");
+      // The quarter-car case's keys: not read here, not unknown.
+      for (const char* k : {"vehicle_data", "tire_relaxation", "design_parameters", "cost", "t_end_s"}) data.has(k);
     } else {
       throw Error("--vehicle must be quarter_car or fourws, got '" + vehicle + "'");
     }
@@ -109,6 +112,7 @@ int main(int argc, char** argv) {
     set.max_levels = mixed.integer("max_levels");
     set.reference_accuracy = ref.number("accuracy");
     set.reference_perturbation = ref.number("perturbation");
+    data.requireAllKeysRead();
     if (vm.count("tolerance")) set.tolerance = vm["tolerance"].as<double>();
     if (vm.count("reference-accuracy")) set.reference_accuracy = vm["reference-accuracy"].as<double>();
     if (vm.count("perturbation")) set.perturbation = vm["perturbation"].as<double>();

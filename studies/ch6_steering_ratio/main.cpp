@@ -126,6 +126,7 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("ch6_steering_ratio", "optimal 4WS steering ratio: linear law, nonlinear map, fit",
                                  argc, argv, opts);
     const auto speeds = parseList(vm["speeds-m-s"].as<std::string>(), "--speeds-m-s");
+    for (double U : speeds) study::checkSpeed({U, "--speeds-m-s"});
     const double fmin = requirePositive(vm["front-min-deg"].as<double>(), "--front-min-deg");
     const double fstep = requirePositive(vm["front-step-deg"].as<double>(), "--front-step-deg");
     const double fmax = requirePositive(vm["front-max-deg"].as<double>(), "--front-max-deg");

@@ -10,6 +10,7 @@
 #include "path_study.h"
 #include "study.h"
 #include "vdyn/analyses/analyses.h"
+#include "vdyn/core/events.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/path/path.h"
 #include "vdyn/vehicles/standard_registry.h"
@@ -33,8 +34,12 @@ RunResult runOne(const SceneDescription& base, const ParamReader& m, const std::
   const TransientSettings settings = TransientSettings::fields().read(
       ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
   BuiltScene built = scene.build();
-  const TransientRun tr = runTransient(
-      built, settings, [&](const std::string&, double tEnd) { return study::progress(name, tEnd); });
+  // Leaving the path (|path distance| beyond 2 m), a spin-out or a rollover
+  // stops the run with the event and its time (core/events.h).
+  EventMonitor events(built.scene());
+  const TransientRun tr = runTransient(built, settings, [&](const std::string&, double tEnd) {
+    return events.callback(study::progress(name, tEnd));
+  });
   study::endProgress();
   const Recorder& rec = *tr.recorder;
   const RunSummary& run = tr.run;
@@ -46,6 +51,7 @@ RunResult runOne(const SceneDescription& base, const ParamReader& m, const std::
   study::writePathCsv(r.path_csv, *path, 10.0, 20.0);
   const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
   r.summary = {{"name", name},
+               {"events", events.toJson()},
                {"path", m.child("path").json()},
                {"gains", m.child("gains").json()},
                {"max_path_error_m", err.max_abs},
@@ -76,8 +82,9 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("ch7_closed_loop",
                                  "closed-loop lane change and J-turn of the nonlinear bicycle (7.3)", argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
-    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
-    requirePositive(U0, "--speed-m-s");
+    const double U0 = study::checkSpeed(study::optionOr(vm, "speed-m-s", data, "speed_m_s"));
+    SimulationSettings base;
+    base.report_interval_s = requirePositive(data.number("report_interval_s"), data.at("report_interval_s"));
     IntegratorSettings integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, integrator);
     integrator.validate();
@@ -86,15 +93,22 @@ int main(int argc, char** argv) {
         {{"vehicle.data", resolveDataPath(data.string("bicycle_data"))},
          {"vehicle.initial_speed_m_s", U0},
          {"plugins.speed_hold.speed_m_s", U0},
-         {"analysis.report_interval_s", data.number("report_interval_s")},
+         {"analysis.report_interval_s", base.report_interval_s},
          {"analysis.integrator",
           {{"method", integrator.method}, {"accuracy", integrator.accuracy},
            {"constraint_tolerance", integrator.constraint_tolerance}, {"max_step_s", integrator.max_step_s}}}});
-    SimulationSettings base;
     base.integrator = integrator;
     const std::string out = study::outputDir(vm, "ch7_closed_loop");
     const auto wall0 = std::chrono::steady_clock::now();
 
+    for (const char* name : {"lane_change", "j_turn"}) {  // read and check everything before the first run
+      const ParamReader m = data.child(name);
+      makeReferencePath(m.child("path"));
+      PathControlParams::fromParams(m.child("gains"));
+      study::checkRunTimes({m.number("t_end_s"), m.at("t_end_s")},
+                           {base.report_interval_s, data.at("report_interval_s")});
+    }
+    data.requireAllKeysRead();
     std::vector<RunResult> runs;
     for (const char* name : {"lane_change", "j_turn"}) runs.push_back(runOne(scene, data.child(name), name, out));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -74,10 +74,9 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("ch7_open_loop", "open-loop lane changes and circle of the nonlinear bicycle (7.2)",
                                  argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
-    const double U0 = vm.count("speed-m-s") ? vm["speed-m-s"].as<double>() : data.number("speed_m_s");
-    requirePositive(U0, "--speed-m-s");
+    const double U0 = study::checkSpeed(study::optionOr(vm, "speed-m-s", data, "speed_m_s"));
     SimulationSettings base;
-    base.report_interval_s = data.number("report_interval_s");
+    base.report_interval_s = requirePositive(data.number("report_interval_s"), data.at("report_interval_s"));
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
@@ -97,8 +96,17 @@ int main(int argc, char** argv) {
     std::vector<RunResult> runs;
     const ParamReader lc = data.child("lane_change");
     const double t0 = lc.number("start_time_s"), ramp = lc.number("ramp_s"), hold = lc.number("hold_s"),
-                 cross = lc.number("crossover_s");
-    for (double d : lc.numbers("amplitudes_rad")) {
+                 cross = lc.number("crossover_s"), lcEnd = lc.number("t_end_s");
+    const std::vector<double> amplitudes = lc.numbers("amplitudes_rad");
+    for (std::size_t i = 0; i < amplitudes.size(); ++i)
+      study::checkSteerAngle({amplitudes[i], lc.at("amplitudes_rad") + "[" + std::to_string(i) + "]"}, false);
+    const ParamReader ci = data.child("circle");
+    const double ciAngle = study::checkSteerAngle({ci.number("angle_rad"), ci.at("angle_rad")}, false);
+    const double ciStart = ci.number("start_time_s"), ciRamp = ci.number("ramp_s"), ciEnd = ci.number("t_end_s");
+    study::checkRunTimes({lcEnd, lc.at("t_end_s")}, {base.report_interval_s, data.at("report_interval_s")});
+    study::checkRunTimes({ciEnd, ci.at("t_end_s")}, {base.report_interval_s, data.at("report_interval_s")});
+    data.requireAllKeysRead();
+    for (double d : amplitudes) {
       // Figure 7.2a: up, hold, across, hold, back.
       const Json cmd = {{"type", "steps"},
                         {"initial_rad", 0.0},
@@ -108,16 +116,15 @@ int main(int argc, char** argv) {
                           {{"start_time_s", t0 + ramp + hold + cross + hold}, {"duration_s", ramp}, {"change_rad", d}}}}};
       char name[64];
       std::snprintf(name, sizeof name, "lane_change_%gdeg", std::round(d * 180 / SimTK::Pi * 10) / 10);
-      runs.push_back(runOne(scene, cmd, lc.number("t_end_s"), name, out));
+      runs.push_back(runOne(scene, cmd, lcEnd, name, out));
     }
-    const ParamReader ci = data.child("circle");
     runs.push_back(runOne(scene,
                           {{"type", "smooth_step"},
                            {"initial_rad", 0.0},
-                           {"final_rad", ci.number("angle_rad")},
-                           {"start_time_s", ci.number("start_time_s")},
-                           {"duration_s", ci.number("ramp_s")}},
-                          ci.number("t_end_s"), "circle", out));
+                           {"final_rad", ciAngle},
+                           {"start_time_s", ciStart},
+                           {"duration_s", ciRamp}},
+                          ciEnd, "circle", out));
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
 
     Json list = Json::array();

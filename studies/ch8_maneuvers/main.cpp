@@ -16,6 +16,7 @@
 
 #include "path_study.h"
 #include "study.h"
+#include "vdyn/core/events.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/path_control/path_control.h"
@@ -50,6 +51,7 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
   RunResult r;
   r.csv = out + "/" + sc.id + "_" + strategyName + ".csv";
   r.summary = {{"scenario", sc.id}, {"strategy", strategyName}, {"speed_m_s", sc.speed_m_s}};
+  std::unique_ptr<EventMonitor> events;
   try {
     // The composition is the scene (scenes/ch8_maneuvers.json: 4WS vehicle,
     // state-driven front and rear steering, path controller, rear-steer law,
@@ -75,23 +77,20 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                   "rear_control.target_rad", "rear_control.tracking_error_rad", "path_control.e1_m",
                   "path_control.e2", "path_control.e3_m", "path_control.e4", "path_control.path_distance_m",
                   "path_control.lateral_acceleration_m_s2"});
-    // A run that has lost the path is stopped (an unstable loop would crawl on
-    // with ever smaller steps) and recorded as failed.
-    const auto progress = study::progress(sc.id + " " + strategyName, sim.t_end_s);
-    const Scene& scene0 = scene;
-    const double limit = sc.abort_path_error_m;
-    const RunSummary run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
-      if (progress) progress(st);
-      const double d = scene0.evalOutput("path_control.path_distance_m", st);
-      if (!(std::abs(d) <= limit))
-        throw Error("lost the path: distance " + formatValue(d) + " m beyond abort_path_error_m = " +
-                    formatValue(limit) + " m at t = " + formatValue(st.getTime()) + " s");
-    });
+    // A run that has left the path is stopped (an unstable loop would crawl on
+    // with ever smaller steps) and recorded as failed, with the event's time.
+    EventLimits limits;
+    limits.left_path_distance_m = sc.abort_path_error_m;
+    limits.stop_on_spin_out = limits.stop_on_rollover = false;  // reported, the run goes on
+    events = std::make_unique<EventMonitor>(scene, limits);
+    const RunSummary run =
+        simulate(scene, s, sim, &rec, events->callback(study::progress(sc.id + " " + strategyName, sim.t_end_s)));
     study::endProgress();
     rec.writeCsv(r.csv);
     const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
     const auto& kr = rec.column("rear_control.kr");
     r.summary.update({{"completed", true},
+                      {"events", events->toJson()},
                       {"peak_lateral_velocity_m_s", study::maxAbs(rec.column("chassis.lateral_speed_m_s"))},
                       {"max_path_error_m", err.max_abs},
                       {"rms_path_error_m", err.rms},
@@ -115,6 +114,7 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
     for (auto& c : msg)
       if (c == '\n') c = ' ';
     r.summary.update({{"completed", false}, {"reason", msg}});
+    if (events) r.summary["events"] = events->toJson();
     r.csv.clear();
   }
   return r;
@@ -207,10 +207,10 @@ int main(int argc, char** argv) {
       Scenario sc;
       sc.id = r.string("id");
       sc.description = r.string("description");
-      sc.speed_m_s = requirePositive(r.number("speed_m_s"), r.at("speed_m_s"));
+      sc.speed_m_s = study::checkSpeed({r.number("speed_m_s"), r.at("speed_m_s")});
       sc.t_end_s = requirePositive(r.number("t_end_s"), r.at("t_end_s"));
       sc.abort_path_error_m = requirePositive(data.number("abort_path_error_m"), data.at("abort_path_error_m"));
-      sc.path_json = r.child("path").json();
+      sc.path_json = r.raw("path");
       if (reading == "half" && sc.path_json.value("type", "") == "lane_change") {
         // The seed's distance is each half: the lane change spans twice it.
         const double length = sc.path_json.at("length_m").get<double>();
@@ -223,8 +223,10 @@ int main(int argc, char** argv) {
       for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
         sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
       sc.rear = r.has("rear_steer_gains") ? RearSteerParams::fromParams(r.child("rear_steer_gains")) : rearDefault;
+      study::checkRunTimes({sc.t_end_s, r.at("t_end_s")}, {base.report_interval_s, data.at("report_interval_s")});
       scenarios.push_back(sc);
     }
+    data.requireAllKeysRead();
     if (vm.count("scenario")) {
       std::vector<Scenario> chosen;
       for (const auto& id : splitList(vm["scenario"].as<std::string>())) {

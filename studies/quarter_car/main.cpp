@@ -23,17 +23,22 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("quarter_car", "chapter 4 quarter car on a sine road, cost psi = int z''^2 dt",
                                  argc, argv, opts);
     // The scene (scenes/quarter_car.json) composed and run as `vdyn run` does;
-    // the options become scene overrides.
+    // the options become scene overrides, checked and named as given.
     std::vector<Override> o = {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}};
     if (vm.count("integrator")) o.push_back({"analysis.integrator.method", vm["integrator"].as<std::string>()});
-    if (vm.count("accuracy")) o.push_back({"analysis.integrator.accuracy", vm["accuracy"].as<double>()});
-    if (vm.count("t-end-s"))
-      o.push_back({"analysis.t_end_s", requirePositive(vm["t-end-s"].as<double>(), "--t-end-s")});
-    if (vm.count("report-interval-s")) o.push_back({"analysis.report_interval_s", vm["report-interval-s"].as<double>()});
+    if (vm.count("accuracy"))
+      o.push_back({"analysis.integrator.accuracy", study::optionOr(vm, "accuracy", 0.0, "").value});
+    if (vm.count("t-end-s")) o.push_back({"analysis.t_end_s", study::optionOr(vm, "t-end-s", 0.0, "").value});
+    if (vm.count("report-interval-s"))
+      o.push_back({"analysis.report_interval_s", study::optionOr(vm, "report-interval-s", 0.0, "").value});
     const SceneDescription scene = SceneDescription::fromFile("scenes/quarter_car.json", standardRegistry(), o);
     const TransientSettings settings = TransientSettings::fields().read(
         ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
     const SimulationSettings sim = settings.simulation();
+    study::checkRunTimes(
+        {sim.t_end_s, vm.count("t-end-s") ? "--t-end-s" : scene.path() + ": analysis.t_end_s"},
+        {sim.report_interval_s,
+         vm.count("report-interval-s") ? "--report-interval-s" : scene.path() + ": analysis.report_interval_s"});
     const std::string out = study::outputDir(vm, "quarter_car");
 
     BuiltScene built = scene.build();

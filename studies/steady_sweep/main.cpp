@@ -19,9 +19,13 @@
 using namespace vdyn;
 
 namespace {
-std::vector<double> range(double a, double b, double step, const std::string& what) {
-  requirePositive(step, what + " step");
+std::vector<double> range(double a, double b, double step, const std::string& what, const std::string& stepName) {
+  requirePositive(step, stepName);
   if (!(b >= a)) throw Error(what + ": the end (" + formatValue(b) + ") is below the start (" + formatValue(a) + ")");
+  if ((b - a) / step > 1000)
+    throw Error(stepName + " = " + formatValue(step) + " gives " + formatValue(std::floor((b - a) / step) + 1) +
+                " points from " + formatValue(a) + " to " + formatValue(b) + " (at most 1001; " + stepName +
+                " must be at least " + formatValue((b - a) / 1000) + ")");
   std::vector<double> v;
   for (int i = 0; a + i * step <= b + 1e-9 * step; ++i) v.push_back(a + i * step);
   return v;
@@ -44,11 +48,16 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("steady_sweep", "steady turning over speed x front steering angle by continuation", argc,
                                  argv, opts);
     const double deg = SimTK::Pi / 180;
-    const auto speeds = range(vm["speed-min-m-s"].as<double>(), vm["speed-max-m-s"].as<double>(),
-                              vm["speed-step-m-s"].as<double>(), "--speed-min-m-s .. --speed-max-m-s");
-    const auto fronts = range(vm["front-min-deg"].as<double>(), vm["front-max-deg"].as<double>(),
-                              vm["front-step-deg"].as<double>(), "--front-min-deg .. --front-max-deg");
-    for (double U : speeds) requirePositive(U, "--speed-min-m-s");
+    // Ranges first, with the option names: a speed step of 1e-300 or a top
+    // speed of 1e12 is refused here, not after the memory runs out.
+    const double speedMin = study::checkSpeed(study::optionOr(vm, "speed-min-m-s", 0.0, ""));
+    const double speedMax = study::checkSpeed(study::optionOr(vm, "speed-max-m-s", 0.0, ""));
+    const double speedStep = requireFinite(vm["speed-step-m-s"].as<double>(), "--speed-step-m-s");
+    const double frontMin = study::checkSteerAngle(study::optionOr(vm, "front-min-deg", 0.0, "", deg), true) / deg;
+    const double frontMax = study::checkSteerAngle(study::optionOr(vm, "front-max-deg", 0.0, "", deg), true) / deg;
+    const double frontStep = requireFinite(vm["front-step-deg"].as<double>(), "--front-step-deg");
+    const auto speeds = range(speedMin, speedMax, speedStep, "--speed-min-m-s .. --speed-max-m-s", "--speed-step-m-s");
+    const auto fronts = range(frontMin, frontMax, frontStep, "--front-min-deg .. --front-max-deg", "--front-step-deg");
     const double ratio = requireFinite(vm["rear-ratio"].as<double>(), "--rear-ratio");
     const std::string out = study::outputDir(vm, "steady_sweep");
 
@@ -73,9 +82,30 @@ int main(int argc, char** argv) {
          "lateral_acceleration_m_s2,iterations,least_damped_real_per_s,least_damped_imag_per_s\n";
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<int> iterations;
-    int points = 0, stable = 0, unstable = 0, none = 0;
+    int points = 0, stable = 0, unstable = 0, none = 0, refused = 0;
     double solveTime = 0, stabilityTime = 0;
-    Json byRatio = Json::array();
+    Json byRatio = Json::array(), labels = Json::array();
+    // The branch check (issue 12, item 5): the yaw rate follows the steering's
+    // sign, and from one point to the next it changes like the steering angle
+    // within a factor kJump (r_new/r_prev against delta_new/delta_prev); a
+    // solution outside is another branch, refused, and the step is bisected.
+    const double kJump = 2.0;
+    const double firstDeg = std::min(0.01, fronts.front());  // a first step that stays in the linear range
+    ContinuationOptions copt;
+    copt.max_bisections = 6;
+    copt.accept = [&](const SteadyStateResult* prev, double prevDeg, const SteadyStateResult& next, double fdeg) {
+      const double r = sc.evalOutput("chassis.yaw_rate_rad_s", next.state);
+      if (fdeg == 0) return std::string();
+      if (!(r * fdeg > 0))
+        return "yaw rate " + formatValue(r) + " rad/s against the steering's sign (front " + formatValue(fdeg) + " deg)";
+      if (!prev || prevDeg == 0) return std::string();
+      const double rp = sc.evalOutput("chassis.yaw_rate_rad_s", prev->state);
+      const double q = (r / rp) / (fdeg / prevDeg);
+      if (!(q <= kJump && q >= 1 / kJump))
+        return "yaw rate " + formatValue(r) + " rad/s after " + formatValue(rp) + " rad/s at " + formatValue(prevDeg) +
+               " deg: it changed " + formatValue(q) + " times as much as the steering (bound " + formatValue(kJump) + ")";
+      return std::string();
+    };
     std::printf("steady_sweep: %zu speeds x %zu front angles x rear ratios {0, %g}\n", speeds.size(), fronts.size(), ratio);
     std::printf("  %6s %6s  %s\n", "ratio", "U m/s", "largest front angle with a stable steady state (deg); median iterations");
     for (double kr : {0.0, ratio}) {
@@ -84,25 +114,41 @@ int main(int argc, char** argv) {
         SimTK::State start = built.vehicle->makeInitialState(U);
         hold.setAdjustable(start, "speed_m_s", U);
         const auto ts = std::chrono::steady_clock::now();
-        // The branch starts at straight running (0 deg: the initial state is
-        // its solution) and follows the front angle up.
-        std::vector<double> values = {0.0};
-        values.insert(values.end(), fronts.begin(), fronts.end());
-        auto pts = followSteadyState(solver, start, values, [&](SimTK::State& st, double fdeg) {
-          front.setAdjustable(st, "angle_rad", fdeg * deg);
-          rear.setAdjustable(st, "angle_rad", kr * fdeg * deg);
-        });
+        // Every speed's branch starts at straight running (0 deg: the initial
+        // state is its solution), takes a first small step, and follows the
+        // front angle up with the branch check above.
+        std::vector<double> values = {0.0, firstDeg};
+        for (double v : fronts)
+          if (v > firstDeg) values.push_back(v);
+        auto pts = followSteadyState(
+            solver, start, values,
+            [&](SimTK::State& st, double fdeg) {
+              front.setAdjustable(st, "angle_rad", fdeg * deg);
+              rear.setAdjustable(st, "angle_rad", kr * fdeg * deg);
+            },
+            copt);
         if (!pts.front().converged) throw Error("steady_sweep: straight running at " + formatValue(U) + " m/s did not converge: " + pts.front().failure);
         pts.erase(pts.begin());
+        if (firstDeg < fronts.front() && pts.front().converged) pts.erase(pts.begin());  // not a requested angle
         solveTime += std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
         double largestStable = 0;
         std::vector<int> its;
+        int lastStable = -1;  // stability of the previous reported point: -1 none, 0 unstable, 1 stable
+        double lastDeg = 0;
         for (const auto& p : pts) {
           ++points;
           f << kr << ',' << U << ',' << p.value << ',' << kr * p.value << ',';
           if (!p.converged) {
             ++none;
-            f << "no_steady_state,,,,,,,\n";
+            const bool jump = p.failure.rfind("branch jump refused", 0) == 0;
+            const bool ended = p.failure.rfind("the branch ended", 0) == 0;
+            refused += jump;
+            f << (jump ? "branch_jump_refused" : ended ? "beyond_branch_end" : "no_steady_state") << ",,,,,,,\n";
+            if (lastStable >= 0 && !ended)
+              labels.push_back({{"rear_ratio", kr}, {"speed_m_s", U}, {"from_front_deg", lastDeg},
+                                {"to_front_deg", p.value}, {"label", jump ? "branch_jump_refused" : "branch_end"},
+                                {"reason", p.failure}});
+            lastStable = -1;
             continue;
           }
           const auto tst = std::chrono::steady_clock::now();
@@ -111,6 +157,14 @@ int main(int argc, char** argv) {
           const double r = sc.evalOutput("chassis.yaw_rate_rad_s", p.result.state);
           (st.stable ? stable : unstable)++;
           if (st.stable) largestStable = std::max(largestStable, p.value);
+          // A change of stability between two points of the branch, located to
+          // the interval between them (a Hopf or fold point lies inside).
+          if (lastStable >= 0 && lastStable != int(st.stable))
+            labels.push_back({{"rear_ratio", kr}, {"speed_m_s", U}, {"from_front_deg", lastDeg},
+                              {"to_front_deg", p.value},
+                              {"label", st.stable ? "unstable_to_stable" : "stable_to_unstable"}});
+          lastStable = int(st.stable);
+          lastDeg = p.value;
           iterations.push_back(p.result.iterations);
           its.push_back(p.result.iterations);
           f << (st.stable ? "stable" : "unstable") << ',' << U / r << ','
@@ -132,6 +186,10 @@ int main(int argc, char** argv) {
                                              {"stable_points", stable},
                                              {"unstable_points", unstable},
                                              {"no_steady_state_points", none},
+                                             {"branch_jumps_refused", refused},
+                                             {"branch_check", {{"yaw_rate_follows_steering_sign", true},
+                                                               {"max_change_factor", kJump}}},
+                                             {"branch_labels", labels},
                                              {"median_iterations_per_point", median},
                                              {"max_iterations_per_point", iterations.empty() ? -1 : iterations.back()},
                                              {"solve_wall_time_s", solveTime},
@@ -148,18 +206,26 @@ int main(int argc, char** argv) {
         char title[64];
         std::snprintf(title, sizeof title, "rear/front = %g", kr);
         std::vector<study::Series> rad, slip;
+        int colour = 0;
         for (double U : speeds) {
-          char filt[64], lab[32];
-          std::snprintf(filt, sizeof filt, "rear_ratio=%g;speed_m_s=%g", kr, U);
+          ++colour;
+          char filt[96], lab[48], styleS[64], styleU[64];
           std::snprintf(lab, sizeof lab, "%g m/s", U);
-          rad.push_back({csv, "front_deg", "path_radius_m", lab, filt});
-          slip.push_back({csv, "front_deg", "side_slip_rad", lab, filt});
+          std::snprintf(styleS, sizeof styleS, "with linespoints lw 2 pt 7 lc %d", colour);
+          std::snprintf(styleU, sizeof styleU, "with points pt 6 ps 1.5 lc %d", colour);
+          for (const char* status : {"stable", "unstable"}) {
+            const bool isStable = status[0] == 's';
+            std::snprintf(filt, sizeof filt, "rear_ratio=%g;speed_m_s=%g;status=%s", kr, U, status);
+            const std::string label = isStable ? std::string(lab) : std::string(lab) + " unstable (open)";
+            rad.push_back({csv, "front_deg", "path_radius_m", label, filt, isStable ? styleS : styleU});
+            slip.push_back({csv, "front_deg", "side_slip_rad", label, filt, isStable ? styleS : styleU});
+          }
         }
-        study::PlotSpec pr{out + "/radius_" + tag + ".png", std::string("Steady path radius, ") + title,
+        study::PlotSpec pr{out + "/radius_" + tag + ".png", std::string("Steady path radius, ") + title + " (filled: stable, open: unstable)",
                            "front steering angle (deg)", "path radius (m)", rad};
         pr.logy = true;
         pr.points = true;
-        study::PlotSpec ps{out + "/side_slip_" + tag + ".png", std::string("Steady side slip, ") + title,
+        study::PlotSpec ps{out + "/side_slip_" + tag + ".png", std::string("Steady side slip, ") + title + " (filled: stable, open: unstable)",
                            "front steering angle (deg)", "side slip (rad)", slip};
         ps.points = true;
         plots.push_back(pr);

@@ -92,8 +92,10 @@ int main(int argc, char** argv) {
                                  "Gim and Fiala tire characteristics (lateral, longitudinal, combined slip)",
                                  argc, argv, opts);
     const std::string dataFile = vm["data"].as<std::string>();
-    const TireParams params =
-        TireParams::fromParams(ParamReader::fromFile(dataFile).child("tire").child("params"));
+    const ParamReader data = ParamReader::fromFile(dataFile);
+    const TireParams params = TireParams::fromParams(data.child("tire").child("params"));
+    data.child("tire").has("plugin");  // the vehicle's tire plugin: the curves show every model
+    data.child("tire").requireAllKeysRead();
     const std::string out = study::outputDir(vm, "tire_curves");
 
     std::map<std::string, std::shared_ptr<const TireModel>> models;

@@ -53,15 +53,16 @@ BicycleParams BicycleParams::fromParams(const ParamReader& r) {
   p.fork = RigidBodyParams::fromParams(r.child("fork"));
   const ParamReader tire = v.child("tire");
   p.tire_plugin = tire.string("plugin");
-  Json tireParams = tire.child("params").json();
+  ParamReader tireParams = tire.child("params");
   if (r.has("tire")) {
     const ParamReader t = r.child("tire");
     p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
-    if (t.has("params")) tireParams.merge_patch(t.child("params").json());
+    if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
   }
-  p.tire = TireParams::fromParams(ParamReader::fromJson(tireParams, r.where() + " tire.params"));
+  p.tire = TireParams::fromParams(tireParams);
   if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
   p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
+  for (const char* k : {"chassis", "front_right", "rear_right", "tire"}) v.child(k).requireAllKeysRead();
   p.validate();
   return p;
 }

@@ -59,7 +59,8 @@ void DoubleWishboneParams::validate(const std::string& w) const {
   upper_ball.validate(w + ".upper_ball");
   upper_pivot.validate(w + ".upper_pivot");
   if (!(wheel_spin_axis.norm() > 0.5)) throw Error(w + ".wheel_spin_axis must be a unit vector");
-  requireNonNegative(spring_stiffness_N_per_m, w + ".spring.stiffness_N_per_m");
+  // 0 would let the corner collapse onto its bump stop geometry with no word.
+  requirePositive(spring_stiffness_N_per_m, w + ".spring.stiffness_N_per_m");
   requireNonNegative(damper_N_s_per_m, w + ".spring.damping_N_s_per_m");
   requirePositive(spring_free_length_m, w + ".spring.free_length_m");
 }

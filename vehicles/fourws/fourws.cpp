@@ -40,6 +40,7 @@ FourWsParams FourWsParams::fromParams(const ParamReader& r) {
   p.corner_model = r.stringOr("corner_model", p.corner_model);
   if (p.corner_model != "constrained" && p.corner_model != "reduced")
     throw Error(r.where() + ": corner_model must be \"constrained\" or \"reduced\", got \"" + p.corner_model + "\"");
+  r.requireAllKeysRead();
   p.validate();
   return p;
 }

@@ -18,12 +18,6 @@ void QuarterCarParams::validate() const {
   if (tire_plugin.empty()) throw Error("quarter car tire plugin name is empty");
 }
 
-/// Applies the keys of `patch` on top of `base` (objects merged recursively).
-static Json merged(Json base, const Json& patch) {
-  base.merge_patch(patch);
-  return base;
-}
-
 QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r) {
   QuarterCarParams p;
   const ParamReader vehicle = ParamReader::fromFile(r.string("vehicle_data"));
@@ -31,18 +25,20 @@ QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r) {
   // The quarter car's own values are patched onto the vehicle data, so each
   // value lives in one data file: the corner and tire from App. A, the
   // chapter 4 values (m3, K, D, Cz, ...) in the quarter-car file.
-  Json corner = vehicle.child(cornerName).json();
-  if (r.has("corner_overrides")) corner = merged(corner, r.child("corner_overrides").json());
-  p.corner = DoubleWishboneParams::fromParams(ParamReader::fromJson(corner, r.where() + " " + cornerName));
+  ParamReader corner = vehicle.child(cornerName);
+  if (r.has("corner_overrides")) corner = corner.mergedWith(r.child("corner_overrides"));
+  p.corner = DoubleWishboneParams::fromParams(corner);
+  corner.requireAllKeysRead();
   const ParamReader tire = vehicle.child("tire");
   p.tire_plugin = tire.string("plugin");
-  Json tireParams = tire.child("params").json();
+  ParamReader tireParams = tire.child("params");
   if (r.has("tire")) {
     const ParamReader t = r.child("tire");
     p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
-    if (t.has("params")) tireParams = merged(tireParams, t.child("params").json());
+    if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
   }
-  p.tire = TireParams::fromParams(ParamReader::fromJson(tireParams, r.where() + " tire.params"));
+  p.tire = TireParams::fromParams(tireParams);
+  tire.requireAllKeysRead();
   p.chassis_mass_kg = r.number("chassis_mass_kg");
   p.road = RoadParams::fromParams(r.child("road"));
   p.upper_pivot_offset_m = r.numberOr("upper_pivot_offset_m", 0.0);

@@ -106,6 +106,17 @@ class TransientAnalysis : public Analysis {
     TransientSettings::fields().read(r, s_);
     s_.simulation().validate();
     requirePositive(s_.t_end_s, r.at("t_end_s"));
+    // Physical ranges, bounds in the message (a run of more than a day, or more
+    // than 1e6 samples, is a typing error, not a study).
+    if (s_.t_end_s > 1e5) throw Error(r.at("t_end_s") + " must lie in (0, 1e5] s, got " + formatValue(s_.t_end_s));
+    const double dt = s_.report_interval_s;
+    if (!(dt >= 0)) throw Error(r.at("report_interval_s") + " must be >= 0 (0 = none), got " + formatValue(dt));
+    if (dt > s_.t_end_s)
+      throw Error(r.at("report_interval_s") + " (" + formatValue(dt) + " s) must not exceed " + r.at("t_end_s") + " (" +
+                  formatValue(s_.t_end_s) + " s)");
+    if (dt > 0 && s_.t_end_s / dt > 1e6)
+      throw Error(r.at("report_interval_s") + " = " + formatValue(dt) + " s gives more than 1e6 samples over " +
+                  formatValue(s_.t_end_s) + " s (it must be at least " + formatValue(s_.t_end_s / 1e6) + " s)");
   }
 
  protected:

@@ -248,8 +248,13 @@ std::vector<PathPoint> JTurnPath::DoSample(double in, double out, double spacing
 // ---------------------------------------------------------------------------
 std::shared_ptr<const ReferencePath> makeReferencePath(const ParamReader& r) {
   const std::string type = r.string("type");
-  if (type == "lane_change") return std::make_shared<LaneChangePath>(LaneChangeParams::fromParams(r));
-  if (type == "j_turn") return std::make_shared<JTurnPath>(JTurnParams::fromParams(r));
+  std::shared_ptr<const ReferencePath> path;
+  if (type == "lane_change") path = std::make_shared<LaneChangePath>(LaneChangeParams::fromParams(r));
+  if (type == "j_turn") path = std::make_shared<JTurnPath>(JTurnParams::fromParams(r));
+  if (path) {
+    r.requireAllKeysRead();
+    return path;
+  }
   throw Error(r.at("type") + ": unknown path type '" + type + "'; known: j_turn, lane_change");
 }
 

@@ -91,7 +91,12 @@ class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
   class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
    public:
     Implementation(const SimTK::MobilizedBody& body, const Vec3& station, int axis, double tau)
-        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0), body_(body), station_(station), axis_(axis), tau_(tau) {}
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0),
+          matter_(&body.getMatterSubsystem()),
+          body_(body.getMobilizedBodyIndex()),
+          station_(station),
+          axis_(axis),
+          tau_(tau) {}
     Implementation* cloneVirtual() const override { return new Implementation(*this); }
     int getNumTimeDerivativesVirtual() const override { return 0; }
     SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
@@ -105,12 +110,15 @@ class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
     }
     void initializeVirtual(SimTK::State& s) const override { getSubsystem().updZ(s)[zIndex_] = 0; }
     void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
-      const double a = body_.findStationAccelerationInGround(s, station_)[axis_];
+      const double a = matter_->getMobilizedBody(body_).findStationAccelerationInGround(s, station_)[axis_];
       getSubsystem().updZDot(s)[zIndex_] = (a - getSubsystem().getZ(s)[zIndex_]) / tau_;
     }
 
    private:
-    SimTK::MobilizedBody body_;
+    // The body by index, not by handle: a (reference-counted) handle held by a
+    // measure of the same system kept the whole system alive (LeakSanitizer).
+    const SimTK::SimbodyMatterSubsystem* matter_;
+    SimTK::MobilizedBodyIndex body_;
     Vec3 station_;
     int axis_;
     double tau_;

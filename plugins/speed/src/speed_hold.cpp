@@ -121,6 +121,8 @@ void registerSpeedPlugins(PluginRegistry& registry) {
         SpeedHoldEntry e = speedHoldFields().read(spec.params);
         if (spec.bindings.count("chassis")) e.chassis = spec.bindings.at("chassis");
         requirePositive(e.speed_m_s, spec.params.at("speed_m_s"));
+        if (e.speed_m_s > 100)  // a physical range (360 km/h), not a study
+          throw Error(spec.params.at("speed_m_s") + " must lie in (0, 100] m/s, got " + formatValue(e.speed_m_s));
         return std::make_unique<SpeedHoldPlugin>(spec.name, e.chassis, e.speed_m_s);
       },
       {"constant forward speed v_xi^2 + v_eta^2 = U0^2 (3.18), nonholonomic; output <name>.force_N (propulsive)",

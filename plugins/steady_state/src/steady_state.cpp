@@ -385,15 +385,24 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
     haveJacobian_ = false;
     Eigen::Index worst;
     r.cwiseProduct(rScale_).cwiseAbs().maxCoeff(&worst);
+    // Each block against its own tolerance, so the message says which one failed
+    // (a force residual below its tolerance is never reported as the cause).
+    std::string failing, blocksText;
+    auto block = [&](const char* what, double v, double tol, const char* unit) {
+      const bool met = v <= tol;
+      blocksText += std::string(blocksText.empty() ? "" : ", ") + what + " " + formatValue(v) + unit + " (tolerance " +
+                    formatValue(tol) + (met ? ")" : ", NOT met)");
+      if (!met) failing += std::string(failing.empty() ? "" : " and ") + what;
+    };
+    block("max force residual", res.force_residual, opt_.force_tolerance, " N");
+    block("max position-constraint error", res.position_error, opt_.position_tolerance, "");
+    block("max velocity-constraint error", res.velocity_error, opt_.velocity_tolerance, "");
+    block("max zdot", res.rate_residual, opt_.rate_tolerance, "");
     throw SteadyStateError(
         std::string("steady state did not converge") + (stalled ? " (no descent along the Newton direction)" : "") +
-        ": " + std::to_string(res.iterations) + " iterations, scaled residual norm " + formatValue(res.residual_norm) +
-        ", max force residual " + formatValue(res.force_residual) + " N (tolerance " +
-        formatValue(opt_.force_tolerance) + "), max position-constraint error " + formatValue(res.position_error) +
-        ", max velocity-constraint error " + formatValue(res.velocity_error) + ", max zdot " +
-        formatValue(res.rate_residual) +
-        (np_ ? ", max |condition| " + formatValue(res.condition_residual) : std::string()) +
-        "; worst equation: " + describeEquation(int(worst)) + " = " + formatValue(r[worst]));
+        ": " + std::to_string(res.iterations) + " iterations; failing: " + failing + "; " + blocksText +
+        "; worst equation (scaled): " + describeEquation(int(worst)) + " = " + formatValue(r[worst]) +
+        " (no steady state may exist here: beyond the limit of adhesion or past a fold of the branch)");
   }
   res.multipliers.resize(m_);
   for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nu_ + i];
@@ -697,6 +706,12 @@ std::vector<ContinuationPoint> followSteadyState(SteadyStateSolver& solver, cons
     while (true) {
       try {
         SteadyStateResult r = solveAt(target);
+        if (options.accept) {
+          const std::string why = branch.empty() ? options.accept(nullptr, 0.0, r, target)
+                                                 : options.accept(&branch.back().second, branch.back().first, r, target);
+          if (!why.empty())
+            throw Error("branch jump refused at " + formatValue(target) + ": " + why);
+        }
         branch.emplace_back(target, r);
         if (target == v) {
           p.result = std::move(r);

@@ -63,19 +63,27 @@ SteerCommandValue StepSequenceCommand::DoCalc(double t) const {
 
 std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r) {
   const std::string type = r.string("type");
-  if (type == "hold") return std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
-  if (type == "smooth_step") {
+  std::shared_ptr<const SteeringCommand> cmd;
+  if (type == "hold") {
+    cmd = std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
+  } else if (type == "smooth_step") {
     const double d0 = r.numberOr("initial_rad", 0.0);
-    return std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
-                                               r.number("duration_s"));
-  }
-  if (type == "steps") {
+    cmd = std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
+                                              r.number("duration_s"));
+  } else if (type == "steps") {
     std::vector<StepSequenceCommand::Step> steps;
     for (const auto& k : r.array("steps"))
       steps.push_back({k.number("start_time_s"), k.number("duration_s"), k.number("change_rad")});
-    return std::make_shared<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+    cmd = std::make_shared<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+  } else {
+    throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step, steps");
   }
-  throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step, steps");
+  // A road-wheel angle beyond 45 deg is no steering angle (a degree typed as radians).
+  for (const char* k : {"angle_rad", "initial_rad", "final_rad"})
+    if (r.has(k) && std::abs(r.number(k)) > SimTK::Pi / 4)
+      throw Error(r.at(k) + " must lie in [-0.785398, 0.785398] rad (+-45 deg), got " + formatValue(r.number(k)));
+  r.requireAllKeysRead();
+  return cmd;
 }
 
 // ---------------------------------------------------------------------------
@@ -319,16 +327,21 @@ void SteeringPlugin::addStateDriven(Scene& scene) {
   const SimTK::Body::Rigid body(SimTK::MassProperties(1e-3, Vec3(0), SimTK::Inertia(I)));
   steer_ = SimTK::MobilizedBody::Pin(chassis, SimTK::Transform(), body, SimTK::Transform());
   steer_.setDefaultAngle(state_.initial_angle_rad);
-  const auto slot = slot_;
   const std::string who = name();
-  SimTK::Motion::Custom(steer_, new SteeringLawMotion([slot, who](const SimTK::State& s) {
-    if (!slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
+  // The Motion belongs to the steer body, and the law holds handles to that
+  // body: a strong reference here would be a cycle that keeps the whole Simbody
+  // system alive (LeakSanitizer). The plugin (owned by the scene) owns the slot.
+  const std::weak_ptr<LawSlot> weakSlot = slot_;
+  SimTK::Motion::Custom(steer_, new SteeringLawMotion([weakSlot, who](const SimTK::State& s) {
+    const auto slot = weakSlot.lock();
+    if (!slot || !slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
     return slot->law->calcAcceleration(s);
   }));
   scene.addBody(name() + ".steer", steer_);
   for (const auto& k : knuckles_)
     SimTK::Constraint::Custom(
         new SteeringStateConstraintImpl(scene.updMatter(), chassis, scene.getBody(k), spin_K_, steer_));
+  const auto slot = slot_;  // (outputs are the scene's, not the system's: no cycle)
   const SimTK::MobilizedBody::Pin steer = steer_;
   const SimTK::MobilizedBody ch = chassis, first = scene.getBody(knuckles_.front());
   const SimTK::UnitVec3 axis = spin_K_;

@@ -31,6 +31,7 @@ LinearBicycleParams LinearBicycleParams::fromParams(const ParamReader& r) {
   p.rear_axle_to_com_m = r.number("rear_axle_to_com_m");
   p.front_cornering_stiffness_N_per_rad = r.number("front_cornering_stiffness_N_per_rad");
   p.rear_cornering_stiffness_N_per_rad = r.number("rear_cornering_stiffness_N_per_rad");
+  r.requireAllKeysRead();
   try {
     p.validate();
   } catch (const Error& e) {
@@ -164,6 +165,7 @@ KrTable KrTable::fromParams(const ParamReader& r) {
     f.points = row.has("points") ? row.integer("points") : 0;
     t.rows.push_back(f);
   }
+  r.requireAllKeysRead();
   t.validate(r.at("fit"));
   return t;
 }

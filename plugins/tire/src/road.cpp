@@ -32,6 +32,7 @@ RoadParams RoadParams::fromParams(const ParamReader& r) {
   } else if (p.type != "flat") {
     throw Error(r.at("type") + ": unknown road type '" + p.type + "'; known: flat, sine");
   }
+  r.requireAllKeysRead();
   makeRoad(p);  // validates the values
   return p;
 }

@@ -16,6 +16,8 @@ double travelDirection(const ContactKinematics& k, double veps) {
 
 void TireParams::validate(const std::string& w) const {
   requirePositive(unloaded_radius_m, w + ".unloaded_radius_m");
+  if (unloaded_radius_m > 1.5)  // a road vehicle's tire; 3 m stalls the vehicle's assembly and run
+    throw Error(w + ".unloaded_radius_m must lie in (0, 1.5] m, got " + formatValue(unloaded_radius_m));
   requireNonNegative(carcass_radius_m, w + ".carcass_radius_m");
   if (!(carcass_radius_m < unloaded_radius_m))
     throw Error(w + ".carcass_radius_m must be smaller than unloaded_radius_m, got " +
@@ -71,11 +73,7 @@ std::vector<FieldInfo> TireParams::describe() {
 TireParams TireParams::fromParams(const ParamReader& r) {
   TireParams p;
   for (const auto& f : fields()) p.*f.member = r.numberOr(f.key, p.*f.member);
-  for (auto it = r.json().begin(); it != r.json().end(); ++it) {
-    bool known = false;
-    for (const auto& f : fields()) known |= (it.key() == f.key);
-    if (!known && it.key().rfind("_", 0) != 0) throw Error(r.at(it.key()) + ": unknown tire parameter");
-  }
+  r.requireAllKeysRead();  // an unknown key is an error, with the nearest of fields() as a hint
   p.validate(r.where());
   return p;
 }

@@ -9,9 +9,7 @@
 // live in each struct's validate(), so both paths are checked by one function.
 #include <functional>
 #include <memory>
-#include <set>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include <nlohmann/json.hpp>
@@ -23,8 +21,12 @@ namespace vdyn {
 
 using Json = nlohmann::json;
 
-/// Reads and parses a JSON file; throws Error naming the file on I/O or syntax errors.
+/// Reads and parses a JSON file (// comments allowed); throws Error naming the
+/// file, and where it can the line, column and key path, on I/O or syntax
+/// errors, an empty file, a number out of range (1e999) or a duplicate key.
 Json readJsonFile(const std::string& path);
+/// Parses JSON text; `name` names the source in messages (as readJsonFile).
+Json parseJsonText(const std::string& text, const std::string& name);
 
 /// The folders a data-file name is looked up in when it is not an existing
 /// path, in order: each folder of the environment variable VDYN_DATA_PATH
@@ -43,6 +45,11 @@ std::string resolveDataPath(const std::string& name);
 /// dataSearchPath(). Throws Error naming `namingFile` and every folder tried.
 std::string resolveDataPath(const std::string& name, const std::string& namingFile);
 
+/// Typed access to one object of a data file. Every accessor (has, number,
+/// ...Or, child, array, raw) records the key it was asked for, present or not,
+/// so requireAllKeysRead() can reject the keys nobody asked for: a misspelled
+/// or unknown key is an error, never silently ignored. Copies and children
+/// share the record. Keys starting with '_' are comments and never required.
 class ParamReader {
  public:
   /// `where` names the source in messages (file name, optionally key path).
@@ -64,37 +71,43 @@ class ParamReader {
   int integer(const std::string& key) const;
   ParamReader child(const std::string& key) const;
   std::vector<ParamReader> array(const std::string& key) const;
+  /// The raw value of a required key; the caller takes over checking it (the
+  /// key and everything under it count as read).
+  const Json& raw(const std::string& key) const;
+  /// This node's raw JSON (read-only view; marks nothing as read).
   const Json& json() const { return *node_; }
+
+  /// Throws Error naming the file and key path of every key under this node
+  /// (nested objects and array elements opened through child()/array()
+  /// included) that no accessor ever queried, each with the nearest queried key
+  /// of its level as a hint ("did you mean ..."). Loaders call it when done.
+  void requireAllKeysRead() const;
+  /// The problems requireAllKeysRead() would report, one per unknown key
+  /// ("file.json: a.b: unknown key (did you mean 'c'?)"); empty when all were read.
+  std::vector<std::string> unreadKeys() const;
+  /// Marks every key under this node as read (a loader that gave up on a part
+  /// after reporting its error, so the part's keys are not reported again).
+  void markAllRead() const;
+  /// This node with `patch` merged over it (RFC 7396 merge patch), as a new
+  /// reader named like this one. Its requireAllKeysRead() checks the patch's
+  /// keys first and names an unknown one by the patch's own key path (what the
+  /// user wrote). This node and the patch count as read in their own readers.
+  ParamReader mergedWith(const ParamReader& patch) const;
   /// "file.json: a.b" style location of this node, for messages.
   const std::string& where() const { return where_; }
   /// Location of a key under this node.
   std::string at(const std::string& key) const;
 
-  /// Strict keys (CONTRACTS.md item 1). Every accessor above (has, number,
-  /// ...Or, child, array, ...) records the key it was asked for, in a record
-  /// shared by the readers of one root. unreadKeys() lists the location of every
-  /// key under this node (recursing into the objects read through child() and
-  /// array()) that was never asked for, with the nearest asked-for key of the
-  /// same object as a hint; keys starting with '_' are comments and exempt.
-  std::vector<std::string> unreadKeys() const;
-  /// Throws Error listing unreadKeys() (one per line), if any. Loaders call it when done.
-  void requireAllKeysRead() const;
-  /// Marks every key under this node as read (a loader that gave up on a part
-  /// after reporting its error, so the part's keys are not reported again).
-  void markAllRead() const;
-
  private:
-  struct Record {
-    std::set<std::pair<const Json*, std::string>> asked;
-    std::set<const Json*> visited;  ///< nodes a reader was made for
-  };
-  void note(const std::string& key) const;
-  void collectUnread(const Json& node, const std::string& where, std::vector<std::string>& out) const;
+  struct Tracker;
+  ParamReader(std::shared_ptr<const Json> root, const Json* node, std::string where,
+              std::shared_ptr<Tracker> tracker);
   const Json& require(const std::string& key) const;
+  void mark(const std::string& key) const;
   std::shared_ptr<const Json> root_;
+  std::shared_ptr<Tracker> tracker_;
   const Json* node_;
   std::string where_;
-  std::shared_ptr<Record> record_ = std::make_shared<Record>();
 };
 
 }  // namespace vdyn

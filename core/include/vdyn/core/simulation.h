@@ -16,6 +16,23 @@ struct SimulationSettings {
   double report_interval_s = 0.01;
   IntegratorSettings integrator;
 
+  // Run guards: simulate() never hangs silently. Each limit ends the run with a
+  // vdyn::Error that names the guard, the time reached and a state summary.
+  /// Largest number of attempted integrator steps (accepted + rejected); 0 = no limit.
+  long max_steps = 2000000;
+  /// Smallest accepted step, s: `min_step_count` consecutive accepted steps
+  /// shorter than this end the run (the step size has collapsed); 0 = no check.
+  double min_step_s = 1e-9;
+  int min_step_count = 200;
+  /// Wall-clock budget of the run, s; 0 = none.
+  double wall_time_budget_s = 0;
+  /// Largest number of recorder samples (t_end - t0) / report_interval_s.
+  long max_samples = 10000000;
+  /// Progress: called about every `progress_interval_s` of wall time with the
+  /// advanced state (empty: no progress). Studies print a line with it.
+  double progress_interval_s = 0;
+  std::function<void(const SimTK::State&, double wall_s)> progress;
+
   void validate() const;
 };
 
@@ -33,6 +50,10 @@ struct RunSummary {
   double wall_time_s = 0;     ///< wall-clock time of the integration
 };
 
+/// One line describing where a run is: time, and where the scene has them the
+/// chassis position, speed, yaw rate and side slip; else the largest |q| and |u|.
+std::string stateSummary(const Scene& scene, const SimTK::State& state);
+
 /// Largest position-constraint error of a state realized through Position.
 double positionConstraintError(const SimTK::State& state);
 
@@ -41,7 +62,10 @@ double positionConstraintError(const SimTK::State& state);
 /// Integrator::initialize restarts each Measure::Integrate from its initial value. If `recorder`
 /// is given it samples at the start and every report interval. `afterStep` is
 /// called with the advanced state after every accepted step. Integration
-/// failures are rethrown as Error naming the time and the integrator.
+/// failures are rethrown as Error naming the time and the integrator; the run
+/// guards of `settings` (max_steps, min_step_s, wall_time_budget_s, max_samples)
+/// end a run that would not finish with an Error naming the guard, the time
+/// and a state summary (stateSummary()).
 RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& settings,
                     Recorder* recorder = nullptr,
                     const std::function<void(const SimTK::State&)>& afterStep = {});

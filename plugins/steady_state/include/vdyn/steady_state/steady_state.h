@@ -253,6 +253,15 @@ struct ContinuationOptions {
   /// end instead of solving them from a distant start (which can land on
   /// another, unrelated branch).
   bool stop_at_branch_end = true;
+  /// Optional branch check: called for every converged solve (intermediate
+  /// points of a bisected step too) with the previous point of the branch
+  /// (nullptr for the first) and the new one; a non-empty return refuses the
+  /// solution as a jump to another branch (the step is then bisected like a
+  /// failed solve, and the point reported without a steady state with the
+  /// reason if no bisection stays on the branch).
+  std::function<std::string(const SteadyStateResult* previous, double previousValue, const SteadyStateResult& next,
+                            double value)>
+      accept;
 };
 
 /// Follows the steady state as a driving condition takes `values` in turn:
