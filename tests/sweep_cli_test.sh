@@ -14,7 +14,7 @@ fail() { echo "sweep_cli_test: FAILED: $*"; exit 1; }
 "$vdyn" sweep "$sweep" --threads 2 --out "$work/threads" --quiet --no-plots
 outs=(threads)
 if [ -n "$mpirun" ]; then
-  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 \
+  OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1 OMPI_MCA_btl_vader_single_copy_mechanism=none \
     "$mpirun" --oversubscribe -n 3 "$vdyn" sweep "$sweep" --mpi --out "$work/mpi" --quiet --no-plots
   outs+=(mpi)
 fi
