@@ -190,6 +190,9 @@ static bool fileExists(const std::string& p) {
 }
 
 std::string resolveDataPath(const std::string& name, const std::string& namingFile) {
+  struct stat st;
+  if (!name.empty() && name[0] == '/' && stat(name.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
+    throw Error(namingFile + ": data file '" + name + "' is a folder, not a JSON file");
   if (!name.empty() && name[0] == '/') {
     if (fileExists(name)) return name;
     throw Error(namingFile + ": data file '" + name + "' not found");

@@ -13,6 +13,7 @@
 #include "vdyn/core/events.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/path/path.h"
+#include "vdyn/path_control/path_control.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;

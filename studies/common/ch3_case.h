@@ -53,6 +53,10 @@ struct Ch3Case {
     const po::variables_map& v = vm ? *vm : none;
     auto has = [&](const char* k) { return v.count(k) > 0; };
     std::vector<Override> o;
+    {
+      IntegratorSettings given;  // --integrator / --accuracy checked and named as options first
+      applyIntegratorOptions(v, given);
+    }
     // Below 0.5 m/s (the tires' low-speed threshold) the vehicle does not roll
     // but creeps on the slip regularization: 1e-6 m/s crawled at 2e-6 s steps.
     const char* rolling = "a steady turn needs the tires rolling";

@@ -24,6 +24,10 @@ int main(int argc, char** argv) {
                                  argc, argv, opts);
     // The scene (scenes/quarter_car.json) composed and run as `vdyn run` does;
     // the options become scene overrides, checked and named as given.
+    {
+      IntegratorSettings given;  // --integrator / --accuracy checked and named as options first
+      study::applyIntegratorOptions(vm, given);
+    }
     std::vector<Override> o = {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}};
     if (vm.count("integrator")) o.push_back({"analysis.integrator.method", vm["integrator"].as<std::string>()});
     if (vm.count("accuracy"))

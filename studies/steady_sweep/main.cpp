@@ -64,17 +64,13 @@ int main(int argc, char** argv) {
     // The composition is the scene (scenes/steady_sweep.json: held front and
     // rear steering, speed hold), built as `vdyn run` does; speed and angles
     // change through the plugins' adjustables (continuation, no rebuild).
-    const BuiltScene built =
+    // Each speed gets its own scene, built at that speed (a clean start at
+    // straight running: reusing one scene built at the first speed put 7.5 m/s
+    // and, with the rear at 0.25, 12.5 m/s on another branch, issue 12).
+    const SceneDescription description =
         SceneDescription::fromFile("scenes/steady_sweep.json", standardRegistry(),
-                                   {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())},
-                                    {"vehicle.initial_speed_m_s", speeds.front()},
-                                    {"plugins.speed_hold.speed_m_s", speeds.front()}})
-            .build();
-    const Scene& sc = built.scene();
-    const Plugin& front = *sc.findPlugin<Plugin>("front_steer");
-    const Plugin& rear = *sc.findPlugin<Plugin>("rear_steer");
-    const Plugin& hold = *sc.findPlugin<Plugin>("speed_hold");
-    SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
+                                   {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}});
+    const Scene* scp = nullptr;  // the current speed's scene
 
     const std::string csv = out + "/sweep.csv";
     std::ofstream f(csv);
@@ -94,6 +90,7 @@ int main(int argc, char** argv) {
     ContinuationOptions copt;
     copt.max_bisections = 6;
     copt.accept = [&](const SteadyStateResult* prev, double prevDeg, const SteadyStateResult& next, double fdeg) {
+      const Scene& sc = *scp;
       const double r = sc.evalOutput("chassis.yaw_rate_rad_s", next.state);
       if (fdeg == 0) return std::string();
       if (!(r * fdeg > 0))
@@ -111,6 +108,20 @@ int main(int argc, char** argv) {
     for (double kr : {0.0, ratio}) {
       Json rows = Json::array();
       for (double U : speeds) {
+        // A fresh solver per speed: nothing of the previous speed's branch
+        // (its last Jacobian, near that branch's end) seeds this one; reusing
+        // it put 7.5 m/s on another branch (issue 12).
+        const BuiltScene built = description
+                                     .withOverrides({{"vehicle.initial_speed_m_s", U},
+                                                     {"plugins.speed_hold.speed_m_s", U}})
+                                     .build();
+        const Scene& sc = built.scene();
+        scp = &sc;
+        const Plugin& front = *sc.findPlugin<Plugin>("front_steer");
+        const Plugin& rear = *sc.findPlugin<Plugin>("rear_steer");
+        const Plugin& hold = *sc.findPlugin<Plugin>("speed_hold");
+        SteadyStateSolver solver(
+            sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
         SimTK::State start = built.vehicle->makeInitialState(U);
         hold.setAdjustable(start, "speed_m_s", U);
         const auto ts = std::chrono::steady_clock::now();
@@ -144,7 +155,7 @@ int main(int argc, char** argv) {
             const bool ended = p.failure.rfind("the branch ended", 0) == 0;
             refused += jump;
             f << (jump ? "branch_jump_refused" : ended ? "beyond_branch_end" : "no_steady_state") << ",,,,,,,\n";
-            if (lastStable >= 0 && !ended)
+            if (!ended)
               labels.push_back({{"rear_ratio", kr}, {"speed_m_s", U}, {"from_front_deg", lastDeg},
                                 {"to_front_deg", p.value}, {"label", jump ? "branch_jump_refused" : "branch_end"},
                                 {"reason", p.failure}});

@@ -104,7 +104,6 @@ class TransientAnalysis : public Analysis {
  public:
   explicit TransientAnalysis(const ParamReader& r) : Analysis("transient") {
     TransientSettings::fields().read(r, s_);
-    s_.simulation().validate();
     requirePositive(s_.t_end_s, r.at("t_end_s"));
     // Physical ranges, bounds in the message (a run of more than a day, or more
     // than 1e6 samples, is a typing error, not a study).
@@ -117,6 +116,7 @@ class TransientAnalysis : public Analysis {
     if (dt > 0 && s_.t_end_s / dt > 1e6)
       throw Error(r.at("report_interval_s") + " = " + formatValue(dt) + " s gives more than 1e6 samples over " +
                   formatValue(s_.t_end_s) + " s (it must be at least " + formatValue(s_.t_end_s / 1e6) + " s)");
+    s_.simulation().validate();
   }
 
  protected:
