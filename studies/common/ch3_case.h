@@ -23,10 +23,10 @@ struct Ch3Case {
   double speed_m_s = 10;             ///< U0, m/s
   double front_rad = 0, rear_rad = 0;  ///< final steering angles, rad (+ left)
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
-  TransientSettings transient;       ///< the scene's "analysis" (a transient)
-  SimulationSettings sim;            ///< transient.simulation()
+  TransientSettings transient{};     ///< the scene's "analysis" (a transient)
+  SimulationSettings sim{};          ///< transient.simulation()
   /// "constrained" or "reduced" overrides the vehicle file's corner_model; empty keeps it.
-  std::string corner_model;
+  std::string corner_model{};
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
   /// --integrator, --accuracy.
