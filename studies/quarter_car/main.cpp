@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
     study::addIntegratorOptions(opts);
     const auto vm = study::parse("quarter_car", "chapter 4 quarter car on a sine road, cost psi = int z''^2 dt",
                                  argc, argv, opts);
-    // The scene (scenes/quarter_car.json) composed and run as `vdyn run` does;
+    // The scene (scenes/quarter_car_sine_road.json) composed and run as `vdyn run` does;
     // the options become scene overrides, checked and named as given.
     {
       IntegratorSettings given;  // --integrator / --accuracy checked and named as options first
@@ -35,7 +35,7 @@ int main(int argc, char** argv) {
     if (vm.count("t-end-s")) o.push_back({"analysis.t_end_s", study::optionOr(vm, "t-end-s", 0.0, "").value});
     if (vm.count("report-interval-s"))
       o.push_back({"analysis.report_interval_s", study::optionOr(vm, "report-interval-s", 0.0, "").value});
-    const SceneDescription scene = SceneDescription::fromFile("scenes/quarter_car.json", standardRegistry(), o);
+    const SceneDescription scene = SceneDescription::fromFile("scenes/quarter_car_sine_road.json", standardRegistry(), o);
     const TransientSettings settings = TransientSettings::fields().read(
         ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
     const SimulationSettings sim = settings.simulation();
