@@ -205,14 +205,19 @@ TEST(Iso3888, ClosedLoopBicyclePassesSlowAndStrikesConesFast) {
   const BodyOutline body = b->footprint.body(set);
   const Iso3888Layout L = Iso3888Layout::make(2 * body.half_width_m, set.entry_x_m);
   const Iso3888Run slow = runIso3888(scene, set, L, body, 10.0);
-  const Iso3888Run fast = runIso3888(scene, set, L, body, 25.0);
+  // Faster: the controller still brings it through the course (no spin-out,
+  // the path kept), but the body overshoots the side lane and strikes cones.
+  const Iso3888Run fast = runIso3888(scene, set, L, body, 13.0);
   std::printf("slow: completed %d pass %d, %zu strikes, clearance %.3f m, exit %.3f m/s; fast: completed %d pass %d, "
-              "%zu strikes (%s), clearance %.3f m\n",
+              "%zu strikes, clearance %.3f m %s\n",
               slow.completed, slow.pass, slow.cones.strikes.size(), slow.cones.min_clearance_m, slow.exit_speed_m_s,
-              fast.completed, fast.pass, fast.cones.strikes.size(), fast.reason.c_str(), fast.cones.min_clearance_m);
+              fast.completed, fast.pass, fast.cones.strikes.size(), fast.cones.min_clearance_m, fast.reason.c_str());
   EXPECT_TRUE(slow.pass) << slow.reason;
   EXPECT_GT(slow.cones.min_clearance_m, 0.0);
   // Coasting: no drive, so the exit speed is at most the entry speed.
   EXPECT_LE(slow.exit_speed_m_s, 10.0 + 1e-9);
+  EXPECT_TRUE(fast.completed) << fast.reason;
+  EXPECT_FALSE(fast.cones.strikes.empty());
+  EXPECT_LT(fast.cones.min_clearance_m, 0.0);
   EXPECT_FALSE(fast.pass);
 }

@@ -1,6 +1,7 @@
 #include "vdyn/handling/iso3888.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <fstream>
 
@@ -232,18 +233,28 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     SimulationSettings sim;
     // To lead_out_m past section 5 at the entry speed, with time to spare for
     // the speed coasting loses (reached_exit checks the body left the course).
+    // The run stops once the chassis is lead_out_m past section 5.
     sim.t_end_s = 1.3 * (L.endX() + set.lead_out_m) / U;
     sim.report_interval_s = set.sample_s;
     sim.integrator = set.integrator;
-    out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
-      const double d = scene.evalOutput(dist, st);
-      if (!(std::abs(d) <= set.abort_path_error_m))
-        throw Error("lost the path: " + formatValue(d) + " m from it at t = " + formatValue(st.getTime()) + " s");
-      const double beta = scene.evalOutput("chassis.side_slip_rad", st);
-      if (std::abs(beta) > set.spin_limit_rad)
-        throw Error("spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
-                    formatValue(beta * 180 / SimTK::Pi) + " deg)");
-    });
+    struct LeftTheCourse {};
+    const double xStop = L.endX() + set.lead_out_m;
+    const auto wall0 = std::chrono::steady_clock::now();
+    try {
+      out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
+        const double d = scene.evalOutput(dist, st);
+        if (!(std::abs(d) <= set.abort_path_error_m))
+          throw Error("lost the path: " + formatValue(d) + " m from it at t = " + formatValue(st.getTime()) + " s");
+        const double beta = scene.evalOutput("chassis.side_slip_rad", st);
+        if (std::abs(beta) > set.spin_limit_rad)
+          throw Error("spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
+                      formatValue(beta * 180 / SimTK::Pi) + " deg)");
+        if (scene.evalOutput("chassis.x_m", st) > xStop) throw LeftTheCourse{};
+      });
+    } catch (const LeftTheCourse&) {
+      out.run.sim_time_s = rec.time().empty() ? 0.0 : rec.time().back();
+      out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    }
     out.t_s = rec.time();
     out.x_m = rec.column("chassis.x_m");
     out.y_m = rec.column("chassis.y_m");
