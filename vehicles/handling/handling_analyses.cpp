@@ -408,7 +408,7 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
       "sine_with_dwell", [](const ParamReader& r) { return std::make_unique<SineWithDwellAnalysis>(r); },
       {"FMVSS 126 sine with dwell: A at 0.3 g (steady state), 0.7 Hz sine with 500 ms dwell from 1.5 A; yaw-rate "
        "ratios and lateral displacement against the limits; table sine_with_dwell.csv",
-       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "test speed (held)"},
+       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "entry speed (held up to the beginning of steer)"},
                         {"lateral_accel_m_s2", "m/s^2", "2.943", "lateral acceleration defining A"},
                         {"frequency_Hz", "Hz", "0.7", "sine frequency"},
                         {"dwell_s", "s", "0.5", "dwell at the second peak"},
@@ -416,7 +416,7 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
                         {"factor_step", "", "0.5", "amplitude increment / A"},
                         {"max_amplitude_factor", "", "6.5", "last amplitude / A"},
                         {"max_amplitude_rad", "rad", "0.35", "cap on the road-wheel amplitude"},
-                        {"blend_s", "s", "0.05", "smooth blend in/out of the sine"}})});
+                        {"coast", "-", "true", "coast from the beginning of steer (false: speed held)"}})});
   registry.addAnalysis(
       "iso3888_2", [](const ParamReader& r) { return std::make_unique<Iso3888Analysis>(r); },
       {"ISO 3888-2 double lane change (obstacle avoidance): the cone layout from the vehicle width, the scene run "
