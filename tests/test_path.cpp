@@ -183,7 +183,7 @@ TEST(JTurnPath, ErrorsAreRadialOffsetAndDirectionError) {
 TEST(ReferencePath, DataFileErrorsNameTheKey) {
   auto make = [](const Json& j) { return makeReferencePath(ParamReader::fromJson(j, "scene.json path")); };
   EXPECT_EQ(test::errorOf([&] { make({{"type", "spiral"}}); }),
-            "scene.json path: type: unknown path type 'spiral'; known: j_turn, lane_change");
+            "scene.json path: type: unknown path type 'spiral'; known: double_lane_change, j_turn, lane_change");
   EXPECT_EQ(test::errorOf([&] {
               make({{"type", "j_turn"}, {"entry_length_m", 10}, {"radius_m", 30}, {"exit_angle_deg", 200}});
             }),

@@ -1,4 +1,5 @@
 #include "vdyn/core/scene_file.h"
+#include "vdyn/core/plot.h"
 
 #include <cctype>
 #include <filesystem>
@@ -344,6 +345,12 @@ Json runScene(const SceneDescription& scene, const RunOptions& options) {
   for (auto it = r.summary.begin(); it != r.summary.end(); ++it) summary[it.key()] = it.value();
   if (!options.out_dir.empty()) {
     for (const auto& [name, table] : r.tables) table.writeCsv(options.out_dir + "/" + name + ".csv");
+    if (options.plots) {
+      Json pngs = Json::array();
+      for (const auto& f : renderPlots(options.out_dir, r.tables, r.plots))
+        pngs.push_back(std::filesystem::path(f).filename().string());
+      if (!pngs.empty()) summary["plots"] = pngs;
+    }
     const std::string path = options.out_dir + "/summary.json";
     std::ofstream out(path);
     if (!out) throw Error("cannot write '" + path + "'");

@@ -5,12 +5,15 @@
 // against sine-steer simulations), FMVSS 126 sine with dwell. CSV per run,
 // PNG plots, summary.json, printed tables and the 2WS/4WS ranking.
 #include "vdyn/core/text.h"
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "study.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/handling/iso4138.h"
 #include "vdyn/handling/iso7401.h"
 #include "vdyn/handling/sine_with_dwell.h"
@@ -263,6 +266,26 @@ Json sineWithDwell(const Config& c, const std::string& vehicle, const std::strin
           {"max_yaw_ratio_1s", worst1},      {"max_yaw_ratio_1_75s", worst175},
           {"min_lateral_displacement_m", minDisp < 1e300 ? Json(minDisp) : Json(nullptr)}, {"failed_runs", failedRuns}};
 }
+Json iso3888(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
+  const ParamReader p = c.data.child("iso3888");
+  const bool bike = vehicle == "bicycle";
+  std::vector<Override> ov;
+  if (!bike) ov.push_back({"plugins.rear_control.strategy", vehicle.substr(4)});
+  const SceneDescription scene =
+      SceneDescription::fromFile(p.string(bike ? "scene_bicycle" : "scene_fourws"), standardRegistry(), ov);
+  RunOptions opt;
+  opt.out_dir = out + "/iso3888_" + fileTag(vehicle);
+  opt.plots = plots;
+  const Json s = runScene(scene, opt);
+  std::printf("  ISO 3888-2 %-12s highest passing entry speed %.3f m/s (%.1f km/h), lowest failing %s m/s, %zu runs, "
+              "min clearance %.3f m, %.1f s\n",
+              vehicle.c_str(), s["highest_pass_m_s"].get<double>(), s["highest_pass_km_h"].get<double>(),
+              s["lowest_fail_m_s"].is_number() ? formatValue(s["lowest_fail_m_s"].get<double>()).c_str() : "-",
+              s["runs"].size(), s["best_min_clearance_m"].get<double>(), s["wall_time_s"].get<double>());
+  return {{"highest_pass_m_s", s["highest_pass_m_s"]}, {"lowest_fail_m_s", s["lowest_fail_m_s"]},
+          {"top_of_bracket_passes", s["top_of_bracket_passes"]}, {"bracket_m_s", s["bracket_m_s"]},
+          {"tolerance_m_s", s["tolerance_m_s"]}, {"runs", s["runs"].size()}, {"out_dir", opt.out_dir}};
+}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -270,8 +293,8 @@ int main(int argc, char** argv) {
     namespace po = study::po;
     po::options_description opts("Options");
     opts.add_options()("data", po::value<std::string>()->default_value("handling.json"), "study data file")(
-        "test", po::value<std::string>()->default_value("iso4138,iso7401,swd"),
-        "comma-separated tests: iso4138, iso7401, swd")(
+        "test", po::value<std::string>()->default_value("iso4138,iso7401,swd,iso3888"),
+        "comma-separated tests: iso4138, iso7401, swd, iso3888")(
         "vehicle", po::value<std::string>()->default_value("4ws/2ws,4ws/linear,4ws/nonlinear,bicycle"),
         "comma-separated vehicles: 4ws/2ws, 4ws/linear, 4ws/nonlinear, bicycle")(
         "check", "ISO 7401: cross-check the frequency response with sine-steer simulations")(
@@ -287,8 +310,8 @@ int main(int argc, char** argv) {
     const auto tests = splitList(vm["test"].as<std::string>());
     const auto vehicles = splitList(vm["vehicle"].as<std::string>());
     for (const auto& t : tests)
-      if (t != "iso4138" && t != "iso7401" && t != "swd")
-        throw Error("--test: unknown test '" + t + "'; known: iso4138, iso7401, swd");
+      if (t != "iso4138" && t != "iso7401" && t != "swd" && t != "iso3888")
+        throw Error("--test: unknown test '" + t + "'; known: iso4138, iso7401, swd, iso3888");
     for (const auto& v : vehicles)
       if (v != "bicycle" && v != "4ws/2ws" && v != "4ws/linear" && v != "4ws/nonlinear")
         throw Error("--vehicle: unknown vehicle '" + v + "'; known: 4ws/2ws, 4ws/linear, 4ws/nonlinear, bicycle");
@@ -301,13 +324,23 @@ int main(int argc, char** argv) {
         if (t == "iso4138") jv["iso4138"] = iso4138(c, v, out, plots);
         if (t == "iso7401") jv["iso7401"] = iso7401(c, v, out, plots, vm.count("check") > 0);
         if (t == "swd") jv["sine_with_dwell"] = sineWithDwell(c, v, out, plots);
+        if (t == "iso3888") jv["iso3888"] = iso3888(c, v, out, plots);
       }
       summary[v] = jv;
     }
     // 2WS / 4WS ranking on the 4WS vehicle (strategies run): one row per strategy.
-    std::printf("\n  %-14s %10s %10s %10s %10s %10s %10s %8s\n", "vehicle", "ay_lim100", "K0_deg", "t_r90_s",
-                "overshoot", "r_gain", "swd_r1", "swd");
-    for (const auto& v : vehicles) {
+    // Closed loop (path controller, rear-steer law with G1/G2 tracking): only
+    // the ISO 3888-2 column; the others are open loop (the rear angle is the
+    // strategy's target exactly). Ranked by the ISO 3888-2 speed when run.
+    std::vector<std::string> order = vehicles;
+    auto dlc = [&](const std::string& v) {
+      const Json& jv = summary[v];
+      return jv.contains("iso3888") ? jv["iso3888"]["highest_pass_m_s"].get<double>() : -1.0;
+    };
+    std::stable_sort(order.begin(), order.end(), [&](const std::string& a, const std::string& b) { return dlc(a) > dlc(b); });
+    std::printf("\n  %-14s %10s %10s %10s %10s %10s %10s %8s %12s\n", "vehicle", "ay_lim100", "K0_deg", "t_r90_s",
+                "overshoot", "r_gain", "swd_r1", "swd", "dlc_pass_kmh");
+    for (const auto& v : order) {
       const Json& jv = summary[v];
       auto num = [](const Json& j, const char* k) { return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan(""); };
       const double ay = jv.contains("iso4138") ? num(jv["iso4138"][0], "limit_lateral_accel_m_s2") : std::nan("");
@@ -317,8 +350,9 @@ int main(int argc, char** argv) {
       const double rg = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_rate_gain_1_per_s") : std::nan("");
       const double r1 = jv.contains("sine_with_dwell") ? num(jv["sine_with_dwell"], "max_yaw_ratio_1s") : std::nan("");
       const std::string swd = jv.contains("sine_with_dwell") ? (jv["sine_with_dwell"]["pass"].get<bool>() ? "pass" : "FAIL") : "-";
-      std::printf("  %-14s %10.3f %+10.4f %10.4f %10.4f %10.4f %10.4f %8s\n", v.c_str(), ay, k0, tr, os, rg, r1,
-                  swd.c_str());
+      const double dl = jv.contains("iso3888") ? 3.6 * num(jv["iso3888"], "highest_pass_m_s") : std::nan("");
+      std::printf("  %-14s %10.3f %+10.4f %10.4f %10.4f %10.4f %10.4f %8s %12.1f\n", v.c_str(), ay, k0, tr, os, rg, r1,
+                  swd.c_str(), dl);
     }
     study::writeJson(out + "/summary.json", summary);
   });

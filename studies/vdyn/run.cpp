@@ -14,7 +14,8 @@ int runCommand(const std::vector<std::string>& args) {
       "set", po::value<std::vector<std::string>>()->composing(),
       "override a scene value: key.path=value (repeatable; e.g. vehicle.initial_speed_m_s=12, "
       "plugins.front_steer.command.final_rad=0.05, analysis.t_end_s=5)")(
-      "out", po::value<std::string>(), "output folder (default: ./results/<scene name>)");
+      "out", po::value<std::string>(), "output folder (default: ./results/<scene name>)")(
+      "no-plots", "write no PNG plots (gnuplot) next to the CSV files");
   addCommonOptions(opts);
   po::variables_map vm;
   if (!parseArgs(command("run"), args, opts, {"scene"}, vm)) return 0;
@@ -28,6 +29,7 @@ int runCommand(const std::vector<std::string>& args) {
   RunOptions options;
   options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : defaultOutputDir(scene);
   options.progress = [](const std::string& label, double tEnd) { return study::progress(label, tEnd); };
+  options.plots = !vm.count("no-plots");
   const Json summary = runScene(scene, options);
   study::endProgress();
   std::printf("vdyn run: %s (%s): %s/summary.json\n", scene.name().c_str(),

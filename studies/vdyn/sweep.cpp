@@ -159,6 +159,7 @@ int sweepCommand(const std::vector<std::string>& args) {
   const bool runFiles = vm.count("run-files") > 0;
   const SweepRunFunction run = [&](const SweepDescription&, const Variation& v) {
     RunOptions ro;
+    ro.plots = false;  // per-run CSV and summary only: no gnuplot process per run
     if (runFiles) ro.out_dir = out + "/runs/" + std::to_string(v.index);
     return runScene(base.withOverrides(toOverrides(v.settings)), ro);
   };

@@ -1,13 +1,17 @@
 // The handling tests as analyses a scene file names ("analysis": {"type":
-// "iso4138_constant_radius" | "iso7401" | "sine_with_dwell" | "vehicle_report"}).
+// "iso4138_constant_radius" | "iso7401" | "sine_with_dwell" | "iso3888_2" |
+// "vehicle_report"}). iso3888_2 runs the scene itself (closed loop, its own
+// plugins); the others:
 // Each rebuilds the scene's vehicle (type and data file with its overrides)
 // prepared for the tests (handling_vehicles.h): programmable steering, speed
 // hold and the rear-steer strategy named in the settings. Plugins listed in the
 // scene are not used by these analyses (the test defines the steering).
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 
 #include "vdyn/core/scene_file.h"
+#include "vdyn/handling/iso3888.h"
 #include "vdyn/handling/iso4138.h"
 #include "vdyn/handling/iso7401.h"
 #include "vdyn/handling/sine_with_dwell.h"
@@ -185,6 +189,135 @@ class SineWithDwellAnalysis : public Analysis {
   SineWithDwellSettings s_;
 };
 
+/// The vehicle's footprint from the scene's vehicle type and data (width:
+/// widest track + tire_width_m; axle positions along the chassis x axis).
+VehicleFootprint footprintOf(const SceneDescription& d, double tireWidth) {
+  VehicleChoice c;
+  c.tire_width_m = tireWidth;
+  return buildHandling(d, c)->footprint;
+}
+
+Table runTrajectoryTable(const Iso3888Run& q) {
+  Table t;
+  t.columns = {"t_s", "x_m", "y_m", "yaw_deg", "front_deg", "rear_deg", "path_error_m"};
+  for (std::size_t i = 0; i < q.t_s.size(); ++i)
+    t.rows.push_back({q.t_s[i], q.x_m[i], q.y_m[i], q.yaw_rad[i] / kDeg, q.front_rad[i] / kDeg, q.rear_rad[i] / kDeg,
+                      q.path_error_m[i]});
+  return t;
+}
+
+/// Body corner tracks of a run (for the course plot): front-left, front-right,
+/// rear-right, rear-left corners' X and Y.
+Table cornerTable(const Iso3888Run& q, const BodyOutline& body) {
+  Table t;
+  t.columns = {"x_m", "fl_x_m", "fl_y_m", "fr_x_m", "fr_y_m", "rr_x_m", "rr_y_m", "rl_x_m", "rl_y_m"};
+  for (std::size_t i = 0; i < q.t_s.size(); ++i) {
+    const auto c = body.corners(q.x_m[i], q.y_m[i], q.yaw_rad[i]);
+    t.rows.push_back({q.x_m[i], c[0][0], c[0][1], c[1][0], c[1][1], c[2][0], c[2][1], c[3][0], c[3][1]});
+  }
+  return t;
+}
+
+class Iso3888Analysis : public Analysis {
+ public:
+  explicit Iso3888Analysis(const ParamReader& r) : Analysis("iso3888_2"), s_(Iso3888Settings::fromParams(r)) {
+    tire_width_m_ = r.numberOr("tire_width_m", 0.195);
+    requirePositive(tire_width_m_, r.at("tire_width_m"));
+  }
+
+ protected:
+  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
+    const auto t0 = std::chrono::steady_clock::now();
+    const VehicleFootprint fp = footprintOf(ctx.description, tire_width_m_);
+    const Iso3888Result r = findHighestPassingSpeed(ctx.description, s_, fp);
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    AnalysisResult res;
+    Table runs;
+    runs.columns = {"speed_m_s", "speed_km_h", "completed", "pass", "cone_lines_struck", "min_clearance_m",
+                    "exit_speed_m_s", "max_path_error_m", "peak_lateral_accel_m_s2", "peak_front_steer_deg", "steps"};
+    Json jr = Json::array();
+    for (const auto& q : r.runs) {
+      runs.rows.push_back({q.speed_m_s, q.speed_m_s * 3.6, double(q.completed), double(q.pass),
+                           double(q.cones.strikes.size()), q.completed ? q.cones.min_clearance_m : NAN,
+                           q.completed ? q.exit_speed_m_s : NAN, q.completed ? q.max_path_error_m : NAN,
+                           q.completed ? q.peak_lateral_accel_m_s2 : NAN, q.completed ? q.peak_front_steer_deg : NAN,
+                           double(q.run.steps)});
+      Json j = {{"speed_m_s", q.speed_m_s}, {"pass", q.pass}, {"completed", q.completed}};
+      if (!q.completed) j["reason"] = q.reason;
+      Json st = Json::array();
+      for (const auto& c : q.cones.strikes)
+        st.push_back({{"section", c.section}, {"side", c.side}, {"t_s", c.t_s}, {"x_m", c.x_m}});
+      j["strikes"] = st;
+      if (q.completed) j["min_clearance_m"] = q.cones.min_clearance_m;
+      jr.push_back(j);
+    }
+    res.tables.push_back({"iso3888_runs", runs});
+    Table cones;
+    cones.columns = {"x_m", "left_y_m", "right_y_m"};
+    Json lanes = Json::array();
+    for (const auto& l : r.layout.lanes) {
+      cones.rows.push_back({l.x_start_m, l.y_left_m, l.y_right_m});
+      cones.rows.push_back({l.x_end_m, l.y_left_m, l.y_right_m});
+      cones.rows.push_back({NAN, NAN, NAN});  // a gap between sections in the plot
+      lanes.push_back({{"section", l.section}, {"x_start_m", l.x_start_m}, {"x_end_m", l.x_end_m},
+                       {"y_right_m", l.y_right_m}, {"y_left_m", l.y_left_m}, {"width_m", l.width()}});
+    }
+    res.tables.push_back({"iso3888_cones", cones});
+    const Iso3888Run& best = r.runs.at(r.best_run);
+    res.tables.push_back({"iso3888_best", runTrajectoryTable(best)});
+    res.tables.push_back({"iso3888_best_corners", cornerTable(best, r.body)});
+    PlotSpec course{"iso3888_course", "ISO 3888-2: highest passing entry speed " + formatValue(best.speed_m_s) + " m/s",
+                    "X (m)", "Y (m)",
+                    {{"iso3888_cones", "x_m", "left_y_m", "left cone lines"},
+                     {"iso3888_cones", "x_m", "right_y_m", "right cone lines"},
+                     {"iso3888_best_corners", "fl_x_m", "fl_y_m", "front-left corner"},
+                     {"iso3888_best_corners", "fr_x_m", "fr_y_m", "front-right corner"},
+                     {"iso3888_best_corners", "rr_x_m", "rr_y_m", "rear-right corner"},
+                     {"iso3888_best_corners", "rl_x_m", "rl_y_m", "rear-left corner"}}};
+    std::vector<PlotSeries> steerFail;
+    if (r.first_fail_run >= 0) {
+      const Iso3888Run& fail = r.runs[r.first_fail_run];
+      if (!fail.t_s.empty()) {
+        res.tables.push_back({"iso3888_fail", runTrajectoryTable(fail)});
+        res.tables.push_back({"iso3888_fail_corners", cornerTable(fail, r.body)});
+        course.series.push_back({"iso3888_fail_corners", "fl_x_m", "fl_y_m",
+                                 "front-left corner at " + formatValue(fail.speed_m_s) + " m/s (fails)"});
+        course.series.push_back({"iso3888_fail_corners", "rr_x_m", "rr_y_m",
+                                 "rear-right corner at " + formatValue(fail.speed_m_s) + " m/s (fails)"});
+        steerFail = {{"iso3888_fail", "t_s", "front_deg", "front, " + formatValue(fail.speed_m_s) + " m/s (fails)"}};
+      }
+    }
+    res.plots.push_back(course);
+    PlotSpec steer{"iso3888_steering", "ISO 3888-2: road-wheel angles", "t (s)", "angle (deg)",
+                   {{"iso3888_best", "t_s", "front_deg", "front, " + formatValue(best.speed_m_s) + " m/s"},
+                    {"iso3888_best", "t_s", "rear_deg", "rear, " + formatValue(best.speed_m_s) + " m/s"}}};
+    steer.series.insert(steer.series.end(), steerFail.begin(), steerFail.end());
+    res.plots.push_back(steer);
+    res.plots.push_back({"iso3888_runs", "ISO 3888-2 bisection: pass (1) / fail (0) against entry speed",
+                         "entry speed (m/s)", "pass", {{"iso3888_runs", "speed_m_s", "pass", "pass"}}, false, false, true});
+    res.summary = {{"vehicle_width_m", r.layout.vehicle_width_m},
+                   {"body", {{"front_x_m", r.body.front_x_m}, {"rear_x_m", r.body.rear_x_m},
+                             {"half_width_m", r.body.half_width_m}}},
+                   {"lanes", lanes},
+                   {"bracket_m_s", {s_.speed_low_m_s, s_.speed_high_m_s}},
+                   {"tolerance_m_s", s_.speed_tolerance_m_s},
+                   {"highest_pass_m_s", r.highest_pass_m_s},
+                   {"highest_pass_km_h", r.highest_pass_m_s * 3.6},
+                   {"lowest_fail_m_s", nullIfNan(r.lowest_fail_m_s)},
+                   {"top_of_bracket_passes", r.top_passes},
+                   {"best_min_clearance_m", best.cones.min_clearance_m},
+                   {"best_exit_speed_m_s", best.exit_speed_m_s},
+                   {"coasting", s_.speed_hold.empty()},
+                   {"runs", jr},
+                   {"wall_time_s", wall}};
+    return res;
+  }
+
+ private:
+  Iso3888Settings s_;
+  double tire_width_m_;
+};
+
 class VehicleReportAnalysis : public Analysis {
  public:
   explicit VehicleReportAnalysis(const ParamReader& r) : Analysis("vehicle_report") {
@@ -275,7 +408,7 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
       "sine_with_dwell", [](const ParamReader& r) { return std::make_unique<SineWithDwellAnalysis>(r); },
       {"FMVSS 126 sine with dwell: A at 0.3 g (steady state), 0.7 Hz sine with 500 ms dwell from 1.5 A; yaw-rate "
        "ratios and lateral displacement against the limits; table sine_with_dwell.csv",
-       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "test speed (held)"},
+       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "entry speed (held up to the beginning of steer)"},
                         {"lateral_accel_m_s2", "m/s^2", "2.943", "lateral acceleration defining A"},
                         {"frequency_Hz", "Hz", "0.7", "sine frequency"},
                         {"dwell_s", "s", "0.5", "dwell at the second peak"},
@@ -283,7 +416,30 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
                         {"factor_step", "", "0.5", "amplitude increment / A"},
                         {"max_amplitude_factor", "", "6.5", "last amplitude / A"},
                         {"max_amplitude_rad", "rad", "0.35", "cap on the road-wheel amplitude"},
-                        {"blend_s", "s", "0.05", "smooth blend in/out of the sine"}})});
+                        {"coast", "-", "true", "coast from the beginning of steer (false: speed held)"}})});
+  registry.addAnalysis(
+      "iso3888_2", [](const ParamReader& r) { return std::make_unique<Iso3888Analysis>(r); },
+      {"ISO 3888-2 double lane change (obstacle avoidance): the cone layout from the vehicle width, the scene run "
+       "closed loop (its path_control plugin follows the lane centres), cone strikes of the body outline, the highest "
+       "passing entry speed by bisection; tables iso3888_runs, iso3888_cones, iso3888_best(_corners), "
+       "iso3888_fail(_corners)",
+       {{"vehicle_width_m", "m", "0", "b; 0 = widest track + tire_width_m"},
+        {"tire_width_m", "m", "0.195", "tire section width (vehicle width = track + this)"},
+        {"front_overhang_m", "m", "0.8", "body front ahead of the front axle"},
+        {"rear_overhang_m", "m", "0.7", "body rear behind the rear axle"},
+        {"entry_x_m", "m", "30", "straight run before section 1"},
+        {"lead_out_m", "m", "15", "run on after section 5"},
+        {"transition_extension_m", "m", "4", "reference lane changes start/end this far inside the lanes"},
+        {"line_clearance_m", "m", "0.15", "reference line: body side this far from the inside cone lines (< 0: lane centres)"},
+        {"path_controller", "-", "\"path_control\"", "the scene's path_control plugin (its path is replaced)"},
+        {"speed_hold", "-", "\"\"", "the scene's speed_hold plugin set to the entry speed; \"\" = coast"},
+        {"speed_low_m_s", "m/s", "8", "bisection bracket low end (must pass)"},
+        {"speed_high_m_s", "m/s", "30", "bisection bracket high end"},
+        {"speed_tolerance_m_s", "m/s", "0.1", "bisection stops at this bracket width"},
+        {"abort_path_error_m", "m", "2", "a run this far off the path stops and fails"},
+        {"spin_limit_rad", "rad", "0.5", "|side slip| beyond this: spin-out, fails"},
+        {"sample_s", "s", "0.005", "sampling of the motion (cone check)"},
+        {"integrator", "-", "rk_merson 1e-6", "integrator settings"}}});
   registry.addAnalysis(
       "vehicle_report", [](const ParamReader& r) { return std::make_unique<VehicleReportAnalysis>(r); },
       {"static corner/axle loads and heights (equilibrium solver) and suspension kinematics over wheel travel "

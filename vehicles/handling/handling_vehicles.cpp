@@ -31,6 +31,7 @@ std::unique_ptr<HandlingBuild> makeHandlingFourWs(const FourWsParams& params, co
   const SimTK::Vec3 f = wheelCentreInChassis(car.cornerParams(RF)), r = wheelCentreInChassis(car.cornerParams(RR));
   v.wheelbase_m = f[0] - r[0];
   v.width_m = vehicleWidth(2 * std::max(std::abs(f[1]), std::abs(r[1])), tireWidth);
+  b->footprint = {v.width_m, f[0], r[0]};
   v.gravity_m_s2 = params.gravity_m_per_s2;
   const FourWsVehicle* carp = &car;
   const SpeedHoldPlugin* sp = v.speed;
@@ -58,6 +59,7 @@ std::unique_ptr<HandlingBuild> makeHandlingBicycle(const BicycleParams& params, 
   v.wheel_bodies = {"front_axle", "rear_axle"};
   v.wheelbase_m = params.front_axle_m[0] - params.rear_axle_m[0];
   v.width_m = vehicleWidth(std::max(params.front_track_m, params.rear_track_m), tireWidth);
+  b->footprint = {v.width_m, params.front_axle_m[0], params.rear_axle_m[0]};
   v.gravity_m_s2 = params.gravity_m_per_s2;
   const Bicycle* bp = &bike;
   const SpeedHoldPlugin* sp = v.speed;

@@ -1,5 +1,6 @@
 #include "vdyn/handling/handling.h"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <limits>
@@ -144,9 +145,12 @@ void HandlingHistory::writeCsv(const std::string& path) const {
 }
 
 HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double t_end, double sample,
-                                     const IntegratorSettings& integrator, double spinLimit, RunSummary* summary) {
+                                     const IntegratorSettings& integrator, double spinLimit, RunSummary* summary,
+                                     const std::vector<double>& restarts, double coastFrom,
+                                     const SimTK::State* start) {
   v.validate();
-  SimTK::State s = v.make_initial_state(U);
+  SimTK::State s = start ? *start : v.make_initial_state(U);
+  if (start) s.setTime(0);
   v.speed->setSpeed(s, U);
   s.invalidateAll(SimTK::Stage::Position);
   v.scene->getSystem().realize(s, SimTK::Stage::Position);
@@ -156,16 +160,39 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
                           "handling.lateral_accel_m_s2", "chassis.x_m", "chassis.y_m", "chassis.yaw_rad",
                           "chassis.side_slip_rad", "chassis.roll_rad"});
   SimulationSettings sim;
-  sim.t_end_s = t_end;
   sim.report_interval_s = sample;
   sim.integrator = integrator;
-  const RunSummary run = simulate(*v.scene, s, sim, &rec, [&](const SimTK::State& st) {
-    const double beta = v.scene->evalOutput("chassis.side_slip_rad", st);
-    if (std::abs(beta) > spinLimit)
-      throw Error("'" + v.name + "' spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
-                  formatValue(beta * 180 / SimTK::Pi) + " deg beyond " + formatValue(spinLimit * 180 / SimTK::Pi) +
-                  " deg)");
-  });
+  // Segments between the restart times (and the release of the speed hold).
+  std::vector<double> ends;
+  for (double r : restarts)
+    if (r > 0 && r < t_end) ends.push_back(r);
+  if (coastFrom > 0 && coastFrom < t_end) ends.push_back(coastFrom);
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  ends.push_back(t_end);
+  if (coastFrom <= 0) v.speed->setEnabled(s, false);
+  RunSummary run;
+  for (double te : ends) {
+    if (s.getTime() >= coastFrom - 1e-12) v.speed->setEnabled(s, false);
+    if (!(te > s.getTime())) continue;
+    sim.t_end_s = te;
+    const RunSummary seg = simulate(*v.scene, s, sim, &rec, [&](const SimTK::State& st) {
+      const double beta = v.scene->evalOutput("chassis.side_slip_rad", st);
+      if (std::abs(beta) > spinLimit)
+        throw Error("'" + v.name + "' spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
+                    formatValue(beta * 180 / SimTK::Pi) + " deg beyond " + formatValue(spinLimit * 180 / SimTK::Pi) +
+                    " deg)");
+    });
+    // The integrator may stop a rounding short of te; the next segment must
+    // start at the restart time itself (its command from the right).
+    s.setTime(te);
+    const RunSummary prev = run;
+    run = seg;
+    run.steps += prev.steps, run.attempts += prev.attempts, run.realizations += prev.realizations;
+    run.projections += prev.projections, run.wall_time_s += prev.wall_time_s;
+    run.sim_time_s += prev.sim_time_s;
+    run.max_constraint_error = std::max(run.max_constraint_error, prev.max_constraint_error);
+  }
   if (summary) *summary = run;
   HandlingHistory h;
   h.t_s = rec.time();

@@ -121,22 +121,31 @@ std::vector<double> logFrequencies(double f0, double f1, int n) {
 }
 
 FrequencyResponseResult calcSteeringFrequencyResponse(const HandlingVehicle& v, double U,
-                                                      const std::vector<double>& freqs) {
+                                                      const std::vector<double>& freqs, double ayOp) {
   const auto t0 = std::chrono::steady_clock::now();
   v.validate();
   requirePositive(U, "frequency response speed_m_s");
+  requireFinite(ayOp, "frequency response lateral_accel_m_s2");
   for (double f : freqs) requirePositive(f, "frequency response frequency_Hz");
   const Scene& sc = *v.scene;
-  // Straight running at U: the steady state with the steering at zero.
-  v.holdSteering(U, 0);
-  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, v.chassis_body, v.wheel_bodies, 0.0));
+  // The operating point: straight running at U (steering at zero) or the
+  // steady turn at a_y (front angle solved).
   SimTK::State start = v.make_initial_state(U);
+  double d0 = 0;
+  if (ayOp != 0) {
+    SteadyStateResult turn;
+    d0 = solveSteeringForLateralAcceleration(v, U, ayOp, &turn);
+    start = turn.state;
+  }
+  v.holdSteering(U, d0);
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, v.chassis_body, v.wheel_bodies, 0.0));
   const SteadyStateResult ss = solver.solve(start);
   const HandlingVehicle* vp = &v;
   LinearInput in;
   in.name = "front steering angle (rad)";
   in.typical = 0.01;
-  in.set = [vp, U](SimTK::State&, double d, double dd, double ddd) {
+  in.set = [vp, U, d0](SimTK::State&, double dv, double dd, double ddd) {
+    const double d = d0 + dv;
     vp->front->setValue({d, dd, ddd});
     if (vp->rear) {
       if (vp->rear_strategy) {
@@ -177,14 +186,21 @@ FrequencyResponseResult calcSteeringFrequencyResponse(const HandlingVehicle& v, 
 }
 
 SineSteerResult runSineSteer(const HandlingVehicle& v, double U, double f, double A, const IntegratorSettings& integ,
-                             double rampPeriods, double settle, int fitPeriods) {
+                             double rampPeriods, double settle, int fitPeriods, double ay) {
   requirePositive(f, "sine steer frequency_Hz");
   requirePositive(A, "sine steer amplitude_rad");
   requirePositive(rampPeriods, "sine steer ramp_periods");
   requireNonNegative(settle, "sine steer settle_s");
+  requireFinite(ay, "sine steer lateral_accel_m_s2");
   if (fitPeriods < 1) throw Error("sine steer fit_periods must be >= 1");
+  double d0 = 0;
+  SteadyStateResult turn;
+  if (ay != 0) {
+    d0 = solveSteeringForLateralAcceleration(v, U, ay, &turn);
+    v.scene->getSystem().realize(turn.state, SimTK::Stage::Velocity);
+  }
   const double w = 2 * kPi * f, Tr = rampPeriods / f;
-  v.setSteering(U, [A, w, Tr](double t) {
+  v.setSteering(U, [A, w, Tr, d0](double t) {
     double r = 1, rd = 0, rdd = 0;
     if (t < Tr) {
       const double s = std::max(t, 0.0) / Tr;
@@ -193,13 +209,14 @@ SineSteerResult runSineSteer(const HandlingVehicle& v, double U, double f, doubl
       rdd = (6 - 12 * s) / (Tr * Tr);
     }
     const double sn = std::sin(w * t), cs = std::cos(w * t);
-    return SteerCommandValue{A * r * sn, A * (rd * sn + r * w * cs), A * (rdd * sn + 2 * rd * w * cs - r * w * w * sn)};
+    return SteerCommandValue{d0 + A * r * sn, A * (rd * sn + r * w * cs), A * (rdd * sn + 2 * rd * w * cs - r * w * w * sn)};
   });
   const double tFit0 = Tr + settle, tEnd = tFit0 + fitPeriods / f;
   SineSteerResult out;
   out.frequency_Hz = f;
   const double sample = 1.0 / (f * 200);
-  const HandlingHistory h = runHandlingTransient(v, U, tEnd, sample, integ, 0.5, &out.run);
+  const HandlingHistory h =
+      runHandlingTransient(v, U, tEnd, sample, integ, 0.5, &out.run, {}, 1e300, ay != 0 ? &turn.state : nullptr);
   v.holdSteering(U, 0);
   // Least squares y = a sin(wt) + b cos(wt) + c over the fit window.
   std::vector<std::size_t> idx;

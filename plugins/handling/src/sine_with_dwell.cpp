@@ -16,8 +16,6 @@ void SineWithDwellSettings::validate() const {
   requirePositive(factor_step, "sine with dwell factor_step");
   requirePositive(max_amplitude_rad, "sine with dwell max_amplitude_rad");
   requirePositive(sample_s, "sine with dwell sample_s");
-  requirePositive(blend_s, "sine with dwell blend_s");
-  if (!(blend_s < 0.25 / frequency_Hz)) throw Error("sine with dwell blend_s must be below a quarter period");
 }
 
 SineWithDwellSettings SineWithDwellSettings::fromParams(const ParamReader& r) {
@@ -33,7 +31,7 @@ SineWithDwellSettings SineWithDwellSettings::fromParams(const ParamReader& r) {
   s.max_amplitude_factor = r.numberOr("max_amplitude_factor", s.max_amplitude_factor);
   s.max_amplitude_rad = r.numberOr("max_amplitude_rad", s.max_amplitude_rad);
   s.sample_s = r.numberOr("sample_s", s.sample_s);
-  s.blend_s = r.numberOr("blend_s", s.blend_s);
+  s.coast = r.booleanOr("coast", s.coast);
   if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
   s.validate();
   return s;
@@ -53,34 +51,20 @@ SineWithDwellResult runSineWithDwell(const HandlingVehicle& v, const SineWithDwe
     run.factor = k;
     run.amplitude_rad = std::min(k * out.angle_A_rad, set.max_amplitude_rad);
     const double A = run.amplitude_rad;
-    // delta = A sin(w tau) up to 3/4 period, held at -A for the dwell, then the last quarter.
-    const double tb = set.blend_s, tEndSteer = T + dw;
-    v.setSteering(U, [A, w, T, t0, dw, tb, tEndSteer](double t) {
-      double tau = t - t0;
-      if (tau <= 0 || tau >= tEndSteer) return SteerCommandValue{0, 0, 0};
-      SteerCommandValue raw;
-      if (tau >= 0.75 * T && tau < 0.75 * T + dw) {
-        raw = {-A, 0, 0};
-      } else {
-        const double x = tau >= 0.75 * T + dw ? tau - dw : tau;
-        raw = {A * std::sin(w * x), A * w * std::cos(w * x), -A * w * w * std::sin(w * x)};
-      }
-      // Window: smooth steps over tb at the start and the end (C1 command).
-      auto step = [tb](double x, double& g, double& gd, double& gdd) {
-        if (x >= tb) { g = 1, gd = 0, gdd = 0; return; }
-        const double u = x / tb;
-        g = 3 * u * u - 2 * u * u * u, gd = (6 * u - 6 * u * u) / tb, gdd = (6 - 12 * u) / (tb * tb);
-      };
-      double g1, g1d, g1dd, g2, g2d, g2dd;
-      step(tau, g1, g1d, g1dd);
-      step(tEndSteer - tau, g2, g2d, g2dd);
-      g2d = -g2d;  // d/dt of g(tEnd - tau)
-      const double g = g1 * g2, gd = g1d * g2 + g1 * g2d, gdd = g1dd * g2 + 2 * g1d * g2d + g1 * g2dd;
-      return SteerCommandValue{raw.angle_rad * g, raw.rate_rad_s * g + raw.angle_rad * gd,
-                               raw.accel_rad_s2 * g + 2 * raw.rate_rad_s * gd + raw.angle_rad * gdd};
+    // delta = A sin(w tau) up to 3/4 period, held at -A for the dwell, then the
+    // last quarter; zero before BOS and from COS on. The rate jumps (0 <-> A w)
+    // at BOS and COS: the run restarts there, the command taken from the right.
+    const double tEndSteer = T + dw;
+    v.setSteering(U, [A, w, T, t0, dw, tEndSteer](double t) {
+      const double tau = t - t0;
+      if (tau < 0 || tau >= tEndSteer) return SteerCommandValue{0, 0, 0};
+      if (tau >= 0.75 * T && tau < 0.75 * T + dw) return SteerCommandValue{-A, 0, 0};
+      const double x = tau >= 0.75 * T + dw ? tau - dw : tau;
+      return SteerCommandValue{A * std::sin(w * x), A * w * std::cos(w * x), -A * w * w * std::sin(w * x)};
     });
     try {
-      run.history = runHandlingTransient(v, U, tCos + set.after_s, set.sample_s, set.integrator);
+      run.history = runHandlingTransient(v, U, tCos + set.after_s, set.sample_s, set.integrator, 0.5, nullptr,
+                                         {t0, tCos}, set.coast ? t0 : 1e300);
       run.completed = true;
     } catch (const Error& e) {
       run.reason = e.what();

@@ -104,30 +104,99 @@ PathPoint LaneChangePath::DoCalcReferencePoint(const Vec2& p) const {
   return {Vec2(X, calcY(X)), std::atan(s), calcSecondDerivative(X) / std::pow(1 + s * s, 1.5)};
 }
 
-PathErrors LaneChangePath::DoCalcErrors(const Vec2& p, const Vec2& v) const {
+namespace {
+// Paths that are graphs Y(X) (lane changes): the errors (7.9)-(7.10) and the
+// closest-point distance from Y, Y' and Y''.
+template <class G>
+PathErrors graphErrors(const G& g, const char* what, const Vec2& p, const Vec2& v) {
   // The slope y'/x' (7.10) needs motion along +X.
   if (!(v[0] > 1e-3))
-    throw Error("lane change path: the vehicle must move along +X for the slope error (7.10), got x' = " +
+    throw Error(std::string(what) + ": the vehicle must move along +X for the slope error (7.10), got x' = " +
                 formatValue(v[0]) + " m/s");
-  return {p[1] - calcY(p[0]),                 // (7.9)
-          v[1] / v[0] - calcSlope(p[0])};     // (7.10)
+  return {p[1] - g.calcY(p[0]),                 // (7.9)
+          v[1] / v[0] - g.calcSlope(p[0])};     // (7.10)
 }
 
-double LaneChangePath::DoCalcDistance(const Vec2& p) const {
+template <class G>
+double graphDistance(const G& g, const Vec2& p) {
   // Closest point: Newton on g(X) = (X - px) + (Y(X) - py) Y'(X) = 0 from X = px.
   double X = p[0];
   for (int i = 0; i < 50; ++i) {
-    const double Y = calcY(X), s = calcSlope(X), k = calcSecondDerivative(X);
-    const double g = (X - p[0]) + (Y - p[1]) * s, dg = 1 + s * s + (Y - p[1]) * k;
-    const double dX = -g / (dg > 0.1 ? dg : 0.1);
+    const double Y = g.calcY(X), s = g.calcSlope(X), k = g.calcSecondDerivative(X);
+    const double r = (X - p[0]) + (Y - p[1]) * s, dr = 1 + s * s + (Y - p[1]) * k;
+    const double dX = -r / (dr > 0.1 ? dr : 0.1);
     X += dX;
     if (std::abs(dX) < 1e-13 * std::max(1.0, std::abs(X))) break;
   }
-  const double s = calcSlope(X);
+  const double s = g.calcSlope(X);
   const Vec2 t = Vec2(1, s) / std::sqrt(1 + s * s);
-  const Vec2 d = p - Vec2(X, calcY(X));
+  const Vec2 d = p - Vec2(X, g.calcY(X));
   const double dist = d.norm();
   return cross2(t, d) >= 0 ? dist : -dist;
+}
+
+template <class G>
+PathPoint graphPoint(const G& g, double X) {
+  const double s = g.calcSlope(X);
+  return {Vec2(X, g.calcY(X)), std::atan(s), g.calcSecondDerivative(X) / std::pow(1 + s * s, 1.5)};
+}
+}  // namespace
+
+PathErrors LaneChangePath::DoCalcErrors(const Vec2& p, const Vec2& v) const {
+  return graphErrors(*this, "lane change path", p, v);
+}
+
+double LaneChangePath::DoCalcDistance(const Vec2& p) const { return graphDistance(*this, p); }
+
+// ---------------------------------------------------------------------------
+void DoubleLaneChangeParams::validate() const {
+  requireFinite(start_y_m, "double lane change start_y_m");
+  first.validate();
+  second.validate();
+  if (second.start_x_m < first.start_x_m + first.length_m)
+    throw Error("double lane change: the second lane change (start_x_m " + formatValue(second.start_x_m) +
+                " m) must start where or after the first ends (" + formatValue(first.start_x_m + first.length_m) +
+                " m)");
+}
+
+DoubleLaneChangeParams DoubleLaneChangeParams::fromParams(const ParamReader& r) {
+  DoubleLaneChangeParams p;
+  p.start_y_m = r.numberOr("start_y_m", p.start_y_m);
+  for (auto [key, lc] : {std::pair<const char*, LaneChangeParams*>{"first", &p.first}, {"second", &p.second}}) {
+    const ParamReader c = r.child(key);
+    lc->start_x_m = c.number("start_x_m");
+    lc->length_m = c.number("length_m");
+    lc->shift_m = c.number("shift_m");
+  }
+  p.validate();
+  return p;
+}
+
+DoubleLaneChangePath::DoubleLaneChangePath(const DoubleLaneChangeParams& p) : p_(p) {
+  p_.validate();
+  p_.first.start_y_m = p_.start_y_m;
+  p_.second.start_y_m = 0;  // b_ adds its rise to a_'s
+  a_ = std::make_unique<LaneChangePath>(p_.first);
+  b_ = std::make_unique<LaneChangePath>(p_.second);
+  p_.second.start_y_m = p_.start_y_m + p_.first.shift_m;
+}
+
+double DoubleLaneChangePath::calcY(double X) const { return a_->calcY(X) + b_->calcY(X); }
+double DoubleLaneChangePath::calcSlope(double X) const { return a_->calcSlope(X) + b_->calcSlope(X); }
+double DoubleLaneChangePath::calcSecondDerivative(double X) const {
+  return a_->calcSecondDerivative(X) + b_->calcSecondDerivative(X);
+}
+PathPoint DoubleLaneChangePath::DoCalcReferencePoint(const Vec2& p) const { return graphPoint(*this, p[0]); }
+PathErrors DoubleLaneChangePath::DoCalcErrors(const Vec2& p, const Vec2& v) const {
+  return graphErrors(*this, "double lane change path", p, v);
+}
+double DoubleLaneChangePath::DoCalcDistance(const Vec2& p) const { return graphDistance(*this, p); }
+std::vector<PathPoint> DoubleLaneChangePath::DoSample(double in, double out, double spacing) const {
+  std::vector<PathPoint> pts;
+  const double a = p_.first.start_x_m - in, b = p_.second.start_x_m + p_.second.length_m + out;
+  const int n = std::max(1, static_cast<int>(std::ceil((b - a) / spacing)));
+  for (int i = 0; i <= n; ++i) pts.push_back(graphPoint(*this, a + (b - a) * i / n));
+  return pts;
 }
 
 std::vector<PathPoint> LaneChangePath::DoSample(double in, double out, double spacing) const {
@@ -251,11 +320,13 @@ std::shared_ptr<const ReferencePath> makeReferencePath(const ParamReader& r) {
   std::shared_ptr<const ReferencePath> path;
   if (type == "lane_change") path = std::make_shared<LaneChangePath>(LaneChangeParams::fromParams(r));
   if (type == "j_turn") path = std::make_shared<JTurnPath>(JTurnParams::fromParams(r));
+  if (type == "double_lane_change")
+    path = std::make_shared<DoubleLaneChangePath>(DoubleLaneChangeParams::fromParams(r));
   if (path) {
     r.requireAllKeysRead();
     return path;
   }
-  throw Error(r.at("type") + ": unknown path type '" + type + "'; known: j_turn, lane_change");
+  throw Error(r.at("type") + ": unknown path type '" + type + "'; known: double_lane_change, j_turn, lane_change");
 }
 
 }  // namespace vdyn

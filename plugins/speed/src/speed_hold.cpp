@@ -94,6 +94,14 @@ void SpeedHoldPlugin::setSpeed(SimTK::State& s, double U0) const {
   impl_->setSpeed(s, U0);
 }
 
+void SpeedHoldPlugin::setEnabled(SimTK::State& s, bool enabled) const {
+  if (!impl_) throw Error("speed hold '" + name() + "' is not part of a scene yet");
+  if (enabled)
+    constraint_.enable(s);
+  else
+    constraint_.disable(s);
+}
+
 double SpeedHoldPlugin::calcForce(const SimTK::State& s) const {
   // Simbody applies -G^T lambda; along the (unit at U0) direction of travel the
   // force on the chassis is therefore -lambda.

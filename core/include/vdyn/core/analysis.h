@@ -28,10 +28,30 @@ struct Table {
   void writeCsv(const std::string& path) const;
 };
 
+/// One line of a plot: columns x and y of one of the result's tables.
+struct PlotSeries {
+  std::string table;          ///< a table of the same AnalysisResult
+  std::string x, y;           ///< column names
+  std::string label;          ///< legend ("" = the y column's name)
+};
+
+/// A PNG an analysis asks for (rendered by runScene with gnuplot, plot.h).
+struct PlotSpec {
+  std::string name;           ///< file <name>.png in the output folder
+  std::string title, xlabel, ylabel;
+  std::vector<PlotSeries> series;
+  bool equal_axes = false;    ///< same scale on x and y (trajectories)
+  bool logx = false;
+  bool points = false;        ///< lines with point markers
+};
+
 /// What an analysis hands back.
 struct AnalysisResult {
   Json summary = Json::object();                        ///< becomes summary.json
   std::vector<std::pair<std::string, Table>> tables;    ///< name -> <name>.csv
+  /// PNGs; a table no plot names gets one of its own (every other column
+  /// against the first, one panel each), so every analysis writes a PNG.
+  std::vector<PlotSpec> plots;
   std::vector<std::string> files;                       ///< other files it wrote into the output folder
 };
 

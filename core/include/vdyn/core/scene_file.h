@@ -130,6 +130,8 @@ struct RunOptions {
   std::string out_dir;
   /// Progress of long runs (empty = none).
   ProgressFactory progress;
+  /// PNG plots of the tables (plot.h, gnuplot) next to the CSV files.
+  bool plots = true;
 };
 
 /// Builds the scene, runs its analysis, writes the output files and returns

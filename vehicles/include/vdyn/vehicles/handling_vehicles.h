@@ -6,6 +6,7 @@
 #include <string>
 
 #include "vdyn/handling/handling.h"
+#include "vdyn/handling/iso3888.h"
 #include "vdyn/handling/vehicle_report.h"
 #include "vdyn/vehicles/bicycle.h"
 #include "vdyn/vehicles/fourws.h"
@@ -18,6 +19,7 @@ struct HandlingBuild {
   std::unique_ptr<FourWsVehicle> fourws;  ///< set for the 4WS vehicle
   std::unique_ptr<Bicycle> bicycle;       ///< set for the bicycle
   HandlingVehicle vehicle;
+  VehicleFootprint footprint;             ///< width and axle positions (ISO 3888-2 body outline)
 };
 
 /// Width of the vehicle over the tires, m: the widest track plus one tire
@@ -51,8 +53,8 @@ struct VehicleReport {
 /// zero speed (unknowns q, u, lambda; the speeds solve to zero), kinematics of
 /// the RF and RR corners over `travels_m`.
 VehicleReport makeFourWsReport(const FourWsParams& params, const std::vector<double>& travels_m);
-/// Registers the analyses iso4138_constant_radius, iso7401, sine_with_dwell
-/// and vehicle_report (scene files; vehicles/handling/handling_analyses.cpp).
+/// Registers the analyses iso4138_constant_radius, iso7401, sine_with_dwell,
+/// iso3888_2 and vehicle_report (scene files; vehicles/handling/handling_analyses.cpp).
 void registerHandlingAnalyses(PluginRegistry& registry);
 
 /// The quarter car's report: static equilibrium by solveStaticEquilibrium

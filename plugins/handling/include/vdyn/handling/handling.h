@@ -117,13 +117,20 @@ struct HandlingHistory {
   void writeCsv(const std::string& path) const;
 };
 
-/// Runs the vehicle from straight running at U with its current steering
-/// commands to t_end_s, sampling every `sample_s`. Throws Error (naming the
+/// Runs the vehicle from straight running at U (or from `start`, e.g. a
+/// steady turn's state) with its current steering commands to t_end_s, sampling every `sample_s`. Throws Error (naming the
 /// time) if the integrator fails or the vehicle spins out (|side slip of the
 /// chassis origin| > spin_limit_rad, default 0.5 rad = 28.6 deg).
+/// `restarts_s`: times where the steering command's rate jumps (a profile
+/// that is only C0): the run stops there and the integrator starts afresh
+/// (initialisation projects the velocities onto the new rate), since no
+/// error-controlled step passes a velocity-level step. `coast_from_s`: the
+/// speed hold is released from this time on (the vehicle coasts); infinite =
+/// held throughout.
 HandlingHistory runHandlingTransient(const HandlingVehicle& v, double speed_m_s, double t_end_s, double sample_s,
                                      const IntegratorSettings& integrator, double spin_limit_rad = 0.5,
-                                     RunSummary* summary = nullptr);
+                                     RunSummary* summary = nullptr, const std::vector<double>& restarts_s = {},
+                                     double coast_from_s = 1e300, const SimTK::State* start = nullptr);
 
 /// Linear interpolation of y(t) at t (clamped).
 double interpolate(const std::vector<double>& t, const std::vector<double>& y, double at);

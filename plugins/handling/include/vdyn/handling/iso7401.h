@@ -66,10 +66,15 @@ struct FrequencyResponseResult {
   double wall_time_s = 0;
 };
 
-/// Frequency response about straight running at U (front angle 0) from the
-/// linearised equations of motion; `frequencies_Hz` ascending, > 0.
+/// Frequency response about straight running at U (front angle 0), or about
+/// the steady turn at U with lateral acceleration `lateral_accel_m_s2` (its
+/// front angle solved), from the linearised equations of motion;
+/// `frequencies_Hz` ascending, > 0. About a turn the tires work away from zero
+/// slip, where a tire law with a kink there (the Gim tire's |alpha|) is smooth
+/// and the small-signal theory holds.
 FrequencyResponseResult calcSteeringFrequencyResponse(const HandlingVehicle& vehicle, double speed_m_s,
-                                                      const std::vector<double>& frequencies_Hz);
+                                                      const std::vector<double>& frequencies_Hz,
+                                                      double lateral_accel_m_s2 = 0);
 
 /// Log-spaced frequencies from f0 to f1 (n >= 2 points), Hz.
 std::vector<double> logFrequencies(double f0_Hz, double f1_Hz, int n);
@@ -85,8 +90,10 @@ struct SineSteerResult {
 /// smooth ramp 0 -> 1 over `ramp_periods`; gain and phase of the yaw rate and
 /// a_y by a least-squares fit (sine, cosine, constant) over `fit_periods`
 /// periods after `settle_s` more seconds.
+/// With lateral_accel_m_s2 != 0 the sine is added to the front angle of that
+/// steady turn and the run starts from the turn's steady state.
 SineSteerResult runSineSteer(const HandlingVehicle& vehicle, double speed_m_s, double frequency_Hz,
                              double amplitude_rad, const IntegratorSettings& integrator, double ramp_periods = 1,
-                             double settle_s = 2.0, int fit_periods = 2);
+                             double settle_s = 2.0, int fit_periods = 2, double lateral_accel_m_s2 = 0);
 
 }  // namespace vdyn

@@ -9,8 +9,10 @@
 // peak after the steering changes sign, and the lateral displacement of the
 // chassis origin 1.07 s after the beginning of steer (BOS), against the
 // regulation's limits: <= 35 %, <= 20 %, >= 1.83 m (GVWR <= 3500 kg; required
-// from 5 A). Deviations: the speed is held (3.18) instead of coasting; the
-// sine is blended in and out over blend_s (50 ms) so the command is C1.
+// from 5 A). As the procedure: the speed is held (3.18) up to the beginning of
+// steer and the vehicle coasts from there (`coast`, default true); the sine
+// starts and ends with its full rate (no blend): the integrator restarts at
+// both kinks (runHandlingTransient's restarts).
 #include <string>
 #include <vector>
 
@@ -21,7 +23,7 @@ namespace vdyn {
 struct SineWithDwellSettings {
   /// Keys as the fields (speed_m_s, lateral_accel_m_s2, frequency_Hz, dwell_s,
   /// start_s, after_s, first_factor, factor_step, max_amplitude_factor,
-  /// max_amplitude_rad, sample_s, integrator), each optional.
+  /// max_amplitude_rad, sample_s, coast, integrator), each optional.
   static SineWithDwellSettings fromParams(const ParamReader& r);
 
   double speed_m_s = 80.0 / 3.6;      ///< m/s (80 km/h)
@@ -38,10 +40,9 @@ struct SineWithDwellSettings {
   double displacement_limit_m = 1.83;       ///< at 1.07 s after BOS, m
   double displacement_from_factor = 5.0;    ///< the displacement limit applies from this amplitude / A
   double sample_s = 0.002;
-  /// The command's rate jumps at the beginning and the completion of steer
-  /// (A w): a velocity-level step no integrator passes. The sine is blended
-  /// in and out by smooth steps 3 u^2 - 2 u^3 over blend_s, s.
-  double blend_s = 0.05;
+  /// Coast from the beginning of steer (the speed hold released); false =
+  /// the speed held throughout (a deviation, for comparison).
+  bool coast = true;
   IntegratorSettings integrator;
   SineWithDwellSettings() { integrator.accuracy = 1e-6; }
   void validate() const;

@@ -104,6 +104,38 @@ class LaneChangePath : public ReferencePath {
   double h_;
 };
 
+/// Two lane changes (7.6)-(7.8) in sequence along X (a double lane change, e.g.
+/// the ISO 3888-2 course): Y(X) = Y0 + D1 f1(X) + D2 f2(X), each f the unit
+/// lane change of (7.7) over its own [X0_i, X0_i + L_i]; the second starts
+/// where or after the first ends. Errors as the lane change's (7.9)-(7.10).
+struct DoubleLaneChangeParams {
+  double start_y_m = 0;   ///< Y0, m
+  LaneChangeParams first, second;  ///< their start_y_m is ignored (taken as Y0 and Y0 + D1)
+  void validate() const;
+  /// Keys start_y_m, first {start_x_m, length_m, shift_m}, second {...}.
+  static DoubleLaneChangeParams fromParams(const ParamReader& r);
+};
+
+class DoubleLaneChangePath : public ReferencePath {
+ public:
+  explicit DoubleLaneChangePath(const DoubleLaneChangeParams& p);
+  std::string type() const override { return "double_lane_change"; }
+  const DoubleLaneChangeParams& params() const { return p_; }
+  double calcY(double X) const;
+  double calcSlope(double X) const;
+  double calcSecondDerivative(double X) const;
+
+ protected:
+  PathPoint DoCalcReferencePoint(const SimTK::Vec2& p_G) const override;
+  PathErrors DoCalcErrors(const SimTK::Vec2& p_G, const SimTK::Vec2& v_G) const override;
+  double DoCalcDistance(const SimTK::Vec2& p_G) const override;
+  std::vector<PathPoint> DoSample(double lead_in_m, double lead_out_m, double spacing_m) const override;
+
+ private:
+  DoubleLaneChangeParams p_;
+  std::unique_ptr<LaneChangePath> a_, b_;
+};
+
 /// J-turn (7.19)-(7.24), Figures 7.9-7.10 and 8.11: an entry line from the
 /// start point along the start heading, a circle of radius R tangent to it,
 /// followed for the exit angle alpha_F (the heading change), then the tangent
@@ -154,7 +186,8 @@ class JTurnPath : public ReferencePath {
 /// Angle wrapped to (-pi, pi].
 double wrapAngle(double a_rad);
 
-/// {"type": "lane_change", ...LaneChangeParams keys} or {"type": "j_turn", ...}.
+/// {"type": "lane_change", ...LaneChangeParams keys}, {"type": "double_lane_change",
+/// ...DoubleLaneChangeParams keys} or {"type": "j_turn", ...}.
 /// Throws Error naming the key for an unknown type.
 std::shared_ptr<const ReferencePath> makeReferencePath(const ParamReader& r);
 

@@ -56,6 +56,9 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   /// (continuation in speed); valid once the plugin is in a scene.
   double getSpeed(const SimTK::State& s) const;
   void setSpeed(SimTK::State& s, double speed_m_s) const;
+  /// Releases (false) or re-engages (true) the hold in `s` (the vehicle then
+  /// coasts); invalidates Stage::Instance and above.
+  void setEnabled(SimTK::State& s, bool enabled) const;
   /// Force the constraint applies along the direction of travel, N (needs
   /// Stage::Acceleration).
   double calcForce(const SimTK::State& s) const;

@@ -1,0 +1,25 @@
+#pragma once
+// PNG plots of an analysis's tables with gnuplot (pngcairo), as the studies
+// draw theirs: the CSV files are the data, the gnuplot script is kept next to
+// each PNG (<name>.png.gp) so a user can restyle it.
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "vdyn/core/analysis.h"
+
+namespace vdyn {
+
+/// True if gnuplot is on the PATH.
+bool gnuplotAvailable();
+
+/// Renders `plots` (their tables already written as <out_dir>/<table>.csv)
+/// and, for every table no plot names, a default plot: each column against
+/// the first, one panel per column (at most `max_panels`, the rest listed in
+/// the title). Returns the PNG paths written. Throws Error if gnuplot is
+/// missing or fails, or a plot names a table or column that is not there.
+std::vector<std::string> renderPlots(const std::string& out_dir,
+                                     const std::vector<std::pair<std::string, Table>>& tables,
+                                     const std::vector<PlotSpec>& plots, int max_panels = 12);
+
+}  // namespace vdyn

@@ -1,0 +1,105 @@
+#include "vdyn/core/plot.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <fstream>
+#include <set>
+
+namespace vdyn {
+
+namespace {
+std::string quote(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+const Table& findTable(const std::vector<std::pair<std::string, Table>>& tables, const std::string& name,
+                       const std::string& plot) {
+  for (const auto& [n, t] : tables)
+    if (n == name) return t;
+  throw Error("plot '" + plot + "': no table '" + name + "'");
+}
+
+void requireColumn(const Table& t, const std::string& table, const std::string& col, const std::string& plot) {
+  if (std::find(t.columns.begin(), t.columns.end(), col) == t.columns.end())
+    throw Error("plot '" + plot + "': table '" + table + "' has no column '" + col + "'");
+}
+
+void runGnuplot(const std::string& png, const std::string& script) {
+  const std::string gp = png + ".gp";
+  {
+    std::ofstream g(gp);
+    if (!g) throw Error("cannot write '" + gp + "'");
+    g << "set terminal pngcairo size 1000,650 font 'sans,10'\nset output " << quote(png) << "\n"
+      << "set datafile separator ','\nset grid\nset key noenhanced\n"
+      << script;
+  }
+  const std::string cmd = "gnuplot " + quote(gp) + " 2> " + quote(png + ".log");
+  if (std::system(cmd.c_str()) != 0) {
+    std::ifstream log(png + ".log");
+    std::string line, last;
+    while (std::getline(log, line))
+      if (!line.empty()) last = line;
+    throw Error("gnuplot failed on '" + gp + "': " + last);
+  }
+  std::remove((png + ".log").c_str());
+}
+}  // namespace
+
+bool gnuplotAvailable() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+std::vector<std::string> renderPlots(const std::string& dir, const std::vector<std::pair<std::string, Table>>& tables,
+                                     const std::vector<PlotSpec>& plots, int maxPanels) {
+  std::vector<std::string> written;
+  if (plots.empty() && tables.empty()) return written;
+  if (!gnuplotAvailable())
+    throw Error("gnuplot not found: the PNG plots need it (apt-get install gnuplot-nox), or run without plots");
+  std::set<std::string> named;
+  for (const PlotSpec& p : plots) {
+    if (p.series.empty()) throw Error("plot '" + p.name + "': no series");
+    std::string s = "set title " + quote(p.title) + " noenhanced\nset xlabel " + quote(p.xlabel) +
+                    " noenhanced\nset ylabel " + quote(p.ylabel) + " noenhanced\n";
+    if (p.equal_axes) s += "set size ratio -1\n";
+    if (p.logx) s += "set logscale x\n";
+    s += "plot ";
+    for (std::size_t i = 0; i < p.series.size(); ++i) {
+      const PlotSeries& q = p.series[i];
+      const Table& t = findTable(tables, q.table, p.name);
+      requireColumn(t, q.table, q.x, p.name);
+      requireColumn(t, q.table, q.y, p.name);
+      named.insert(q.table);
+      s += std::string(i ? ", \\\n     " : "") + quote(dir + "/" + q.table + ".csv") + " using (column(" +
+           quote(q.x) + ")):(column(" + quote(q.y) + "))" + (p.points ? " with linespoints lw 2 pt 7" : " with lines lw 2") +
+           " title " + quote(q.label.empty() ? q.y : q.label);
+    }
+    const std::string png = dir + "/" + p.name + ".png";
+    runGnuplot(png, s + "\n");
+    written.push_back(png);
+  }
+  for (const auto& [name, t] : tables) {
+    if (named.count(name) || t.columns.size() < 2 || t.rows.empty()) continue;
+    const int n = std::min<int>(int(t.columns.size()) - 1, maxPanels);
+    const int cols = n <= 3 ? 1 : (n <= 8 ? 2 : 3), rows = (n + cols - 1) / cols;
+    std::string s = "set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) + " title " +
+                    quote(name + (int(t.columns.size()) - 1 > n ? " (first " + std::to_string(n) + " columns)" : "")) +
+                    " noenhanced\nset key off\n";
+    for (int i = 1; i <= n; ++i)
+      s += "set title " + quote(t.columns[i]) + " noenhanced\nset xlabel " + quote(t.columns[0]) +
+           " noenhanced\nplot " + quote(dir + "/" + name + ".csv") + " using (column(" + quote(t.columns[0]) +
+           ")):(column(" + quote(t.columns[i]) + "))" + (t.rows.size() < 40 ? " with linespoints pt 7" : " with lines") +
+           " lw 2\n";
+    s += "unset multiplot\n";
+    const std::string png = dir + "/" + name + ".png";
+    runGnuplot(png, s);
+    written.push_back(png);
+  }
+  return written;
+}
+
+}  // namespace vdyn

@@ -1,0 +1,324 @@
+#include "vdyn/handling/iso3888.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <fstream>
+
+#include "vdyn/core/recorder.h"
+#include "vdyn/handling/handling.h"
+
+namespace vdyn {
+
+using SimTK::Vec2;
+
+double Iso3888Layout::endX() const {
+  double x = entry_x_m;
+  for (double l : section_length_m) x += l;
+  return x;
+}
+
+Iso3888Layout Iso3888Layout::make(double b, double x1) {
+  requirePositive(b, "ISO 3888-2 vehicle_width_m");
+  requireFinite(x1, "ISO 3888-2 entry_x_m");
+  Iso3888Layout L;
+  L.vehicle_width_m = b;
+  L.entry_x_m = x1;
+  const double w1 = 1.1 * b + 0.25, w3 = b + 1.0, w5 = std::max(1.3 * b + 0.25, 3.0);
+  const double* len = L.section_length_m;
+  const double x2 = x1 + len[0], x3 = x2 + len[1], x4 = x3 + len[2], x5 = x4 + len[3], xEnd = x5 + len[4];
+  const double right1 = -0.5 * w1;
+  L.lanes.push_back({1, x1, x2, right1, right1 + w1});
+  L.lanes.push_back({3, x3, x4, right1 + w1 + 1.0, right1 + w1 + 1.0 + w3});
+  L.lanes.push_back({5, x5, xEnd, right1, right1 + w5});
+  return L;
+}
+
+DoubleLaneChangeParams Iso3888Layout::makeReferencePath(double ext, double clearance) const {
+  requireNonNegative(ext, "ISO 3888-2 transition_extension_m");
+  const ConeLane &a = lanes.at(0), &b = lanes.at(1), &c = lanes.at(2);
+  if (!(2 * ext < std::min({a.x_end_m - a.x_start_m, b.x_end_m - b.x_start_m, c.x_end_m - c.x_start_m})))
+    throw Error("ISO 3888-2 transition_extension_m (" + formatValue(ext) +
+                " m): the two transitions' extensions must leave part of each lane straight");
+  const double hb = 0.5 * vehicle_width_m;
+  // Left side `clearance` from the left line (+1) or right side from the right line (-1).
+  auto line = [&](const ConeLane& l, int side) {
+    if (clearance < 0 || l.width() < 2 * (hb + clearance)) return l.centre();
+    return side > 0 ? l.y_left_m - hb - clearance : l.y_right_m + hb + clearance;
+  };
+  const double y1 = line(a, +1), y3 = line(b, -1), y5 = line(c, +1);
+  DoubleLaneChangeParams p;
+  p.start_y_m = y1;
+  p.first.start_x_m = a.x_end_m - ext;
+  p.first.length_m = b.x_start_m - a.x_end_m + 2 * ext;
+  p.first.shift_m = y3 - y1;
+  p.second.start_x_m = b.x_end_m - ext;
+  p.second.length_m = c.x_start_m - b.x_end_m + 2 * ext;
+  p.second.shift_m = y5 - y3;
+  p.validate();
+  return p;
+}
+
+std::vector<Vec2> BodyOutline::corners(double x, double y, double psi) const {
+  const double c = std::cos(psi), s = std::sin(psi);
+  auto at = [&](double bx, double by) { return Vec2(x + c * bx - s * by, y + s * bx + c * by); };
+  return {at(front_x_m, half_width_m), at(front_x_m, -half_width_m), at(rear_x_m, -half_width_m),
+          at(rear_x_m, half_width_m)};
+}
+
+namespace {
+/// The X interval where the convex polygon meets the line Y = yc; false if it does not.
+bool crossingInterval(const std::vector<Vec2>& poly, double yc, double& lo, double& hi) {
+  lo = 1e300, hi = -1e300;
+  for (std::size_t i = 0; i < poly.size(); ++i) {
+    const Vec2 &a = poly[i], &b = poly[(i + 1) % poly.size()];
+    const double da = a[1] - yc, db = b[1] - yc;
+    if (da == 0) lo = std::min(lo, a[0]), hi = std::max(hi, a[0]);
+    if (da * db < 0) {
+      const double x = a[0] + da / (da - db) * (b[0] - a[0]);
+      lo = std::min(lo, x), hi = std::max(hi, x);
+    }
+  }
+  return lo <= hi;
+}
+}  // namespace
+
+ConeCheck checkCones(const Iso3888Layout& L, const BodyOutline& body, const std::vector<double>& t,
+                     const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>& yaw) {
+  if (x.size() != t.size() || y.size() != t.size() || yaw.size() != t.size())
+    throw Error("ISO 3888-2 cone check: sample columns of different lengths");
+  ConeCheck out;
+  std::vector<bool> struck(2 * L.lanes.size(), false);
+  for (std::size_t k = 0; k < t.size(); ++k) {
+    const std::vector<Vec2> poly = body.corners(x[k], y[k], yaw[k]);
+    for (std::size_t i = 0; i < L.lanes.size(); ++i) {
+      const ConeLane& lane = L.lanes[i];
+      for (int side = 0; side < 2; ++side) {
+        const double yc = side == 0 ? lane.y_left_m : lane.y_right_m;
+        double lo, hi;
+        if (!struck[2 * i + side] && crossingInterval(poly, yc, lo, hi) && hi >= lane.x_start_m &&
+            lo <= lane.x_end_m) {
+          struck[2 * i + side] = true;
+          out.strikes.push_back({lane.section, side == 0 ? "left" : "right", t[k], x[k]});
+        }
+      }
+      for (const Vec2& c : poly)
+        if (c[0] >= lane.x_start_m && c[0] <= lane.x_end_m) {
+          const double cl = std::min(c[1] - lane.y_right_m, lane.y_left_m - c[1]);
+          if (cl < out.min_clearance_m) out.min_clearance_m = cl, out.min_clearance_section = lane.section;
+          // A corner beside the lane beyond a cone line: the body passed
+          // outside the cones (or crossed the line between two samples).
+          for (int side = 0; side < 2; ++side)
+            if (!struck[2 * i + side] && (side == 0 ? c[1] > lane.y_left_m : c[1] < lane.y_right_m)) {
+              struck[2 * i + side] = true;
+              out.strikes.push_back({lane.section, side == 0 ? "left" : "right", t[k], x[k]});
+            }
+        }
+    }
+    double rear = 1e300;
+    for (const Vec2& c : poly) rear = std::min(rear, c[0]);
+    if (rear > L.endX()) out.reached_exit = true;
+  }
+  return out;
+}
+
+void Iso3888Settings::validate() const {
+  requireNonNegative(vehicle_width_m, "ISO 3888-2 vehicle_width_m");
+  requireNonNegative(front_overhang_m, "ISO 3888-2 front_overhang_m");
+  requireNonNegative(rear_overhang_m, "ISO 3888-2 rear_overhang_m");
+  requirePositive(entry_x_m, "ISO 3888-2 entry_x_m");
+  requireNonNegative(lead_out_m, "ISO 3888-2 lead_out_m");
+  requireNonNegative(transition_extension_m, "ISO 3888-2 transition_extension_m");
+  if (path_controller.empty()) throw Error("ISO 3888-2 path_controller: must name the scene's path_control plugin");
+  requirePositive(speed_low_m_s, "ISO 3888-2 speed_low_m_s");
+  if (!(speed_high_m_s > speed_low_m_s))
+    throw Error("ISO 3888-2 speed_high_m_s (" + formatValue(speed_high_m_s) + ") must exceed speed_low_m_s (" +
+                formatValue(speed_low_m_s) + ")");
+  requirePositive(speed_tolerance_m_s, "ISO 3888-2 speed_tolerance_m_s");
+  requirePositive(abort_path_error_m, "ISO 3888-2 abort_path_error_m");
+  requirePositive(spin_limit_rad, "ISO 3888-2 spin_limit_rad");
+  requirePositive(sample_s, "ISO 3888-2 sample_s");
+}
+
+Iso3888Settings Iso3888Settings::fromParams(const ParamReader& r) {
+  Iso3888Settings s;
+  s.vehicle_width_m = r.numberOr("vehicle_width_m", s.vehicle_width_m);
+  s.front_overhang_m = r.numberOr("front_overhang_m", s.front_overhang_m);
+  s.rear_overhang_m = r.numberOr("rear_overhang_m", s.rear_overhang_m);
+  s.entry_x_m = r.numberOr("entry_x_m", s.entry_x_m);
+  s.lead_out_m = r.numberOr("lead_out_m", s.lead_out_m);
+  s.transition_extension_m = r.numberOr("transition_extension_m", s.transition_extension_m);
+  s.line_clearance_m = r.numberOr("line_clearance_m", s.line_clearance_m);
+  s.path_controller = r.stringOr("path_controller", s.path_controller);
+  s.speed_hold = r.stringOr("speed_hold", s.speed_hold);
+  s.speed_low_m_s = r.numberOr("speed_low_m_s", s.speed_low_m_s);
+  s.speed_high_m_s = r.numberOr("speed_high_m_s", s.speed_high_m_s);
+  s.speed_tolerance_m_s = r.numberOr("speed_tolerance_m_s", s.speed_tolerance_m_s);
+  s.abort_path_error_m = r.numberOr("abort_path_error_m", s.abort_path_error_m);
+  s.spin_limit_rad = r.numberOr("spin_limit_rad", s.spin_limit_rad);
+  s.sample_s = r.numberOr("sample_s", s.sample_s);
+  if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+  s.validate();
+  return s;
+}
+
+BodyOutline VehicleFootprint::body(const Iso3888Settings& s) const {
+  BodyOutline b;
+  b.front_x_m = front_axle_x_m + s.front_overhang_m;
+  b.rear_x_m = rear_axle_x_m - s.rear_overhang_m;
+  b.half_width_m = 0.5 * (s.vehicle_width_m > 0 ? s.vehicle_width_m : width_m);
+  requirePositive(b.half_width_m, "ISO 3888-2 vehicle width");
+  if (!(b.front_x_m > b.rear_x_m)) throw Error("ISO 3888-2: the body's front must be ahead of its rear");
+  return b;
+}
+
+void Iso3888Run::writeCsv(const std::string& path) const {
+  std::ofstream f(path);
+  if (!f) throw Error("cannot write '" + path + "'");
+  f << "t_s,x_m,y_m,yaw_rad,front_rad,rear_rad,path_error_m\n";
+  f.precision(10);
+  for (std::size_t i = 0; i < t_s.size(); ++i)
+    f << t_s[i] << ',' << x_m[i] << ',' << y_m[i] << ',' << yaw_rad[i] << ',' << front_rad[i] << ',' << rear_rad[i]
+      << ',' << path_error_m[i] << '\n';
+}
+
+namespace {
+/// The scene's plugin object named `name`, or null.
+const Json* findPlugin(const Json& scene, const std::string& name) {
+  if (!scene.contains("plugins")) return nullptr;
+  for (const auto& p : scene.at("plugins"))
+    if (p.contains("name") && p.at("name").get<std::string>() == name) return &p;
+  return nullptr;
+}
+double maxAbs(const std::vector<double>& v) {
+  double m = 0;
+  for (double x : v) m = std::max(m, std::abs(x));
+  return m;
+}
+}  // namespace
+
+Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, const Iso3888Layout& L,
+                      const BodyOutline& body, double U) {
+  requirePositive(U, "ISO 3888-2 entry speed");
+  const Json* pc = findPlugin(desc.json(), set.path_controller);
+  if (!pc)
+    throw Error(desc.path() + ": ISO 3888-2 path_controller '" + set.path_controller + "': no plugin of that name");
+  const std::string frontSteer = pc->value("steering", std::string());
+  std::string rearSteer;
+  for (const auto& p : desc.json().at("plugins"))
+    if (p.value("type", std::string()) == "rear_steer") rearSteer = p.value("rear_steering", std::string());
+  const DoubleLaneChangeParams path = L.makeReferencePath(set.transition_extension_m, set.line_clearance_m);
+  const Json pathJson = {{"type", "double_lane_change"},
+                         {"start_y_m", path.start_y_m},
+                         {"first", {{"start_x_m", path.first.start_x_m}, {"length_m", path.first.length_m}, {"shift_m", path.first.shift_m}}},
+                         {"second", {{"start_x_m", path.second.start_x_m}, {"length_m", path.second.length_m}, {"shift_m", path.second.shift_m}}}};
+  std::vector<Override> ov = {{"vehicle.initial_speed_m_s", U}, {"plugins." + set.path_controller + ".path", pathJson}};
+  if (!set.speed_hold.empty()) {
+    if (!findPlugin(desc.json(), set.speed_hold))
+      throw Error(desc.path() + ": ISO 3888-2 speed_hold '" + set.speed_hold + "': no plugin of that name");
+    ov.push_back({"plugins." + set.speed_hold + ".speed_m_s", U});
+  }
+  Iso3888Run out;
+  out.speed_m_s = U;
+  try {
+    BuiltScene built = desc.withOverrides(ov).build();
+    const Scene& scene = built.scene();
+    SimTK::State s = built.makeInitialState();
+    const std::string dist = set.path_controller + ".path_distance_m";
+    std::vector<std::string> cols = {"chassis.x_m", "chassis.y_m", "chassis.yaw_rad", "chassis.forward_speed_m_s",
+                                     dist, set.path_controller + ".lateral_acceleration_m_s2"};
+    if (!frontSteer.empty()) cols.push_back(frontSteer + ".angle_rad");
+    if (!rearSteer.empty()) cols.push_back(rearSteer + ".angle_rad");
+    Recorder rec(scene, cols);
+    SimulationSettings sim;
+    // To lead_out_m past section 5 at the entry speed, with time to spare for
+    // the speed coasting loses (reached_exit checks the body left the course).
+    // The run stops once the chassis is lead_out_m past section 5.
+    sim.t_end_s = 1.3 * (L.endX() + set.lead_out_m) / U;
+    sim.report_interval_s = set.sample_s;
+    sim.integrator = set.integrator;
+    struct LeftTheCourse {};
+    const double xStop = L.endX() + set.lead_out_m;
+    const auto wall0 = std::chrono::steady_clock::now();
+    try {
+      out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
+        const double d = scene.evalOutput(dist, st);
+        if (!(std::abs(d) <= set.abort_path_error_m))
+          throw Error("lost the path: " + formatValue(d) + " m from it at t = " + formatValue(st.getTime()) + " s");
+        const double beta = scene.evalOutput("chassis.side_slip_rad", st);
+        if (std::abs(beta) > set.spin_limit_rad)
+          throw Error("spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
+                      formatValue(beta * 180 / SimTK::Pi) + " deg)");
+        if (scene.evalOutput("chassis.x_m", st) > xStop) throw LeftTheCourse{};
+      });
+    } catch (const LeftTheCourse&) {
+      out.run.sim_time_s = rec.time().empty() ? 0.0 : rec.time().back();
+      out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    }
+    out.t_s = rec.time();
+    out.x_m = rec.column("chassis.x_m");
+    out.y_m = rec.column("chassis.y_m");
+    out.yaw_rad = rec.column("chassis.yaw_rad");
+    out.path_error_m = rec.column(dist);
+    out.front_rad = frontSteer.empty() ? std::vector<double>(out.t_s.size(), 0.0) : rec.column(frontSteer + ".angle_rad");
+    out.rear_rad = rearSteer.empty() ? std::vector<double>(out.t_s.size(), 0.0) : rec.column(rearSteer + ".angle_rad");
+    out.cones = checkCones(L, body, out.t_s, out.x_m, out.y_m, out.yaw_rad);
+    out.exit_speed_m_s = interpolate(out.x_m, rec.column("chassis.forward_speed_m_s"), L.endX());
+    out.max_path_error_m = maxAbs(out.path_error_m);
+    out.peak_lateral_accel_m_s2 = maxAbs(rec.column(set.path_controller + ".lateral_acceleration_m_s2"));
+    out.peak_front_steer_deg = maxAbs(out.front_rad) * 180 / SimTK::Pi;
+    out.completed = out.cones.reached_exit;
+    if (!out.completed) out.reason = "did not leave section 5 by the end of the run";
+  } catch (const Error& e) {
+    out.completed = false;
+    out.reason = e.what();
+  }
+  out.pass = out.completed && out.cones.strikes.empty();
+  return out;
+}
+
+Iso3888Result findHighestPassingSpeed(const SceneDescription& desc, const Iso3888Settings& set,
+                                      const VehicleFootprint& fp) {
+  set.validate();
+  Iso3888Result r;
+  r.body = fp.body(set);
+  r.layout = Iso3888Layout::make(2 * r.body.half_width_m, set.entry_x_m);
+  auto run = [&](double U) {
+    r.runs.push_back(runIso3888(desc, set, r.layout, r.body, U));
+    return int(r.runs.size()) - 1;
+  };
+  int lo = run(set.speed_low_m_s);
+  if (!r.runs[lo].pass) {
+    const Iso3888Run& q = r.runs[lo];
+    std::string why = q.completed ? std::to_string(q.cones.strikes.size()) + " cone line(s) struck, first in section " +
+                                        std::to_string(q.cones.strikes.front().section) + " (" +
+                                        q.cones.strikes.front().side + ")"
+                                  : q.reason;
+    throw Error("ISO 3888-2: the bracket's low end speed_low_m_s = " + formatValue(set.speed_low_m_s) +
+                " m/s does not pass (" + why + "); lower it");
+  }
+  int hi = run(set.speed_high_m_s);
+  if (r.runs[hi].pass) {
+    r.top_passes = true;
+    r.best_run = hi;
+    r.highest_pass_m_s = set.speed_high_m_s;
+    r.lowest_fail_m_s = std::nan("");
+    return r;
+  }
+  double a = set.speed_low_m_s, b = set.speed_high_m_s;
+  while (b - a > set.speed_tolerance_m_s) {
+    const double m = 0.5 * (a + b);
+    const int k = run(m);
+    if (r.runs[k].pass)
+      a = m, lo = k;
+    else
+      b = m, hi = k;
+  }
+  r.best_run = lo;
+  r.first_fail_run = hi;
+  r.highest_pass_m_s = a;
+  r.lowest_fail_m_s = b;
+  return r;
+}
+
+}  // namespace vdyn
