@@ -52,6 +52,8 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   SpeedHoldPlugin(std::string name, std::string chassisBody, double speed_m_s);
   /// The default speed (the one a new state holds), m/s.
   double speed() const { return U0_; }
+  /// Name of the chassis body whose speed is held.
+  const std::string& chassisBody() const { return chassis_; }
   /// The speed held in `s`, and a way to change it without rebuilding the scene
   /// (continuation in speed); valid once the plugin is in a scene.
   double getSpeed(const SimTK::State& s) const;
