@@ -17,6 +17,14 @@ void ReducedDenseRows::setRows(std::vector<Arm> arms, std::vector<Steer> steers,
 
 void ReducedDenseRows::realizeTopology(SimTK::State& s) const {
   activeIndex_ = forces_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<bool>(false));
+  lambdaIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Dynamics, new SimTK::Value<SimTK::Vector>());
+}
+
+double ReducedDenseRows::speedHoldForce(const SimTK::State& s, int k) const {
+  if (!isActive(s)) throw Error("reduced dense dynamics: speedHoldForce in a state that is not dense");
+  const SimTK::Vector& lambda = SimTK::Value<SimTK::Vector>::downcast(forces_->getCacheEntry(s, lambdaIndex_)).get();
+  // This element applies +G^T lambda (Simbody applies -G^T lambda for its rows).
+  return lambda[int(arms_.size() * 2 + steers_.size()) + k];
 }
 
 bool ReducedDenseRows::isActive(const SimTK::State& s) const {
@@ -158,6 +166,9 @@ void ReducedDenseRows::realizeDynamics(const SimTK::State& s) const {
     r_[i] = a / A_[i * m + i];
   }
   // f += G^T lambda.
+  SimTK::Vector& lambda = SimTK::Value<SimTK::Vector>::updDowncast(forces_->updCacheEntry(s, lambdaIndex_)).upd();
+  lambda.resize(m);
+  for (int i = 0; i < m; ++i) lambda[i] = r_[i];
   for (int i = 0; i < m; ++i) {
     const RowEval& ri = rows_[i];
     for (int k = 0; k < ri.n; ++k) f[ri.u[k]] += ri.g[k] * r_[i];

@@ -293,6 +293,9 @@ void FourWsVehicle::useDenseRows(SimTK::State& s) const {
     } else if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get())) {
       if (sc.getBody(sp->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
         throw Error("4ws: speed hold '" + plugin->name() + "' is not on the chassis" + why);
+      const ReducedDenseRows* dense = dense_;
+      const int k = int(speeds.size());
+      sp->setDisabledForceSource([dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); });
       speeds.push_back({chassis_, sp});
     }
   }

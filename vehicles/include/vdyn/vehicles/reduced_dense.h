@@ -31,8 +31,9 @@
 //
 // Active only in a state where FourWsVehicle::useDenseRows() set its flag
 // (and disabled the Simbody constraints it replaces); in every other state
-// this force does nothing and the Simbody rows act. Constraint multipliers
-// (e.g. speed_hold.force_N) are not available in a dense state.
+// this force does nothing and the Simbody rows act. Simbody's constraint
+// multipliers are not available in a dense state; the speed hold's force
+// (speed_hold.force_N) is read from this element (speedHoldForce).
 // Not thread-safe (workspace in the object), as ReducedKnuckleMobilizer.
 #include <memory>
 #include <vector>
@@ -76,6 +77,9 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   /// Largest position error of the holonomic rows (rad) and velocity error of
   /// every row (rad/s; m/s for the speed hold) in `s` (Stage::Velocity).
   std::pair<double, double> calcRowErrors(const SimTK::State& s) const;
+  /// Force of the k-th speed hold along the direction of travel, N
+  /// (SpeedHoldPlugin::calcForce's sign), in a dense state (Stage::Dynamics).
+  double speedHoldForce(const SimTK::State& s, int k) const;
 
   // Force::Custom::Implementation
   void calcForce(const SimTK::State&, SimTK::Vector_<SimTK::SpatialVec>&, SimTK::Vector_<SimTK::Vec3>&,
@@ -104,6 +108,7 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   std::vector<Steer> steers_;
   std::vector<Speed> speeds_;
   mutable SimTK::DiscreteVariableIndex activeIndex_;
+  mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
   // Workspace.
   mutable std::vector<RowEval> rows_;
   mutable SimTK::Vector udot0_, v_;
