@@ -13,7 +13,7 @@ include(CMakePackageConfigHelpers)
 # Every library a user may link, in dependency order. A target of this list that
 # does not exist (yet) is skipped.
 set(VDYN_EXPORTED_LIBRARIES
-  vdyn_core
+  vdyn_core vdyn_sweep vdyn_sweep_mpi
   vdyn_tire vdyn_steering vdyn_speed vdyn_forces vdyn_path vdyn_path_control
   vdyn_linear_ratio vdyn_rear_steer vdyn_steady_state vdyn_steering_ratio vdyn_sensitivity
   vdyn_plugins vdyn_scene vdyn_analyses

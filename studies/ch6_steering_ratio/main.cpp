@@ -10,9 +10,9 @@
 //  - Table 8.1: Kr = C1 + C2 delta_f^2 (deg) per speed by least squares over
 //    the zero-side-slip points, written as kr_table.json (read by the rear-steer
 //    strategy; --table-copy writes the copy kept in vehicles/data).
-// Speeds run in parallel threads, each with its own vehicle, System and solver.
+// Speeds run through the sweep runner on parallel threads, each with its own
+// scene, System and solver.
 #include <algorithm>
-#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <ctime>
@@ -24,6 +24,7 @@
 
 #include "study.h"
 #include "vdyn/core/scene_file.h"
+#include "vdyn/core/sweep.h"
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
@@ -86,7 +87,6 @@ struct SpeedRun {
   std::vector<OptimalRatioPoint> points;
   std::vector<double> yaw_rate_rad_s;   // per point (NaN without a state)
   double wall_time_s = 0;
-  std::string error;
 };
 
 }  // namespace
@@ -188,10 +188,19 @@ int main(int argc, char** argv) {
     if (oro.stability_skip_max < 0)
       throw Error("--stability-skip-max must be non-negative, got " + std::to_string(oro.stability_skip_max));
     std::vector<SpeedRun> runs(speeds.size());
-    std::atomic<std::size_t> next{0};
-    std::mutex buildMutex;
-    auto worker = [&] {
-      for (std::size_t i; (i = next++) < speeds.size();) {
+    // One variation per speed through the sweep runner (vdyn/core/sweep.h):
+    // threads take speeds one at a time; a speed's full result stays in runs[i]
+    // (one slot per variation, so no two threads share one).
+    SweepDescription sweep;
+    sweep.name = "ch6_steering_ratio";
+    {
+      GridAxis bySpeed{{"speed_m_s"}, {}};
+      for (double U : speeds) bySpeed.values.push_back({U});
+      sweep.addVariations(makeGridVariations({bySpeed}));
+    }
+    auto runSpeed = [&](const SweepDescription&, const Variation& v) {
+      {
+        const std::size_t i = v.index;
         SpeedRun& run = runs[i];
         run.speed_m_s = speeds[i];
         const auto ts = std::chrono::steady_clock::now();
@@ -261,22 +270,22 @@ int main(int argc, char** argv) {
                                              ? NAN
                                              : sc.evalOutput("chassis.yaw_rate_rad_s", p.result.state));
         } catch (const std::exception& e) {
-          run.error = "at " + formatValue(speeds[i]) + " m/s: " + e.what();
+          run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
+          throw Error("at " + formatValue(speeds[i]) + " m/s: " + e.what());
         }
         run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
+        return Json{{"speed_m_s", run.speed_m_s}, {"points", run.points.size()}, {"passes", run.passes}};
       }
     };
     const auto tm = std::chrono::steady_clock::now();
     const std::clock_t cm = std::clock();  // process CPU time, all threads
-    {
-      std::vector<std::thread> pool;
-      for (int k = 0; k < threads; ++k) pool.emplace_back(worker);
-      for (auto& t : pool) t.join();
-    }
+    SweepOptions sweepOptions;
+    sweepOptions.threads = threads;
+    const SweepResult swept = runSweep(sweep, runSpeed, sweepOptions);
     const double mapWall = std::chrono::duration<double>(std::chrono::steady_clock::now() - tm).count();
     const double mapCpu = double(std::clock() - cm) / CLOCKS_PER_SEC;
-    for (const auto& r : runs)
-      if (!r.error.empty()) throw Error(r.error);
+    for (const SweepRow& r : swept.rows)
+      if (!r.ok) throw Error(r.reason);
 
     // --- outputs ----------------------------------------------------------------
     const std::string mapCsv = out + "/kr_map.csv";

@@ -7,17 +7,20 @@
 // steering, Kr, lateral velocity, path error: Figures 8.2-8.17), a CSV per
 // run, and summary.json with key "runs". A run that fails is recorded with
 // completed = false and its reason; the study then exits 1 after writing all.
+// The runs go through the sweep runner (vdyn/core/sweep.h) on --threads threads.
 #include "vdyn/core/text.h"
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
 #include "path_study.h"
 #include "study.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/simulation.h"
+#include "vdyn/core/sweep.h"
 #include "vdyn/path_control/path_control.h"
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/rear_steer/rear_steer.h"
@@ -46,7 +49,7 @@ struct RunResult {
 };
 
 RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::string& strategyName,
-                 const SimulationSettings& baseSim, const std::string& out) {
+                 const SimulationSettings& baseSim, const std::string& out, bool showProgress) {
   RunResult r;
   r.csv = out + "/" + sc.id + "_" + strategyName + ".csv";
   r.summary = {{"scenario", sc.id}, {"strategy", strategyName}, {"speed_m_s", sc.speed_m_s}};
@@ -77,7 +80,8 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                   "path_control.lateral_acceleration_m_s2"});
     // A run that has lost the path is stopped (an unstable loop would crawl on
     // with ever smaller steps) and recorded as failed.
-    const auto progress = study::progress(sc.id + " " + strategyName, sim.t_end_s);
+    const auto progress = showProgress ? study::progress(sc.id + " " + strategyName, sim.t_end_s)
+                                       : std::function<void(const SimTK::State&)>();
     const Scene& scene0 = scene;
     const double limit = sc.abort_path_error_m;
     const RunSummary run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
@@ -87,7 +91,7 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
         throw Error("lost the path: distance " + formatValue(d) + " m beyond abort_path_error_m = " +
                     formatValue(limit) + " m at t = " + formatValue(st.getTime()) + " s");
     });
-    study::endProgress();
+    if (showProgress) study::endProgress();
     rec.writeCsv(r.csv);
     const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
     const auto& kr = rec.column("rear_control.kr");
@@ -110,7 +114,7 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                       {"sim_time_s", run.sim_time_s},
                       {"wall_time_s", run.wall_time_s}});
   } catch (const std::exception& e) {
-    study::endProgress();
+    if (showProgress) study::endProgress();
     std::string msg = e.what();
     for (auto& c : msg)
       if (c == '\n') c = ' ';
@@ -175,6 +179,8 @@ int main(int argc, char** argv) {
         "lane-change-length", po::value<std::string>(),
         "how the seed's lane-change distance reads: 'full' (the whole lane change, X_f - X_0; docs/equations.md) or "
         "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
+        "threads", po::value<int>()->default_value(0),
+        "worker threads for the runs (0: one per core); the outputs do not depend on it")(
         "no-plots", "skip the PNG plots");
     study::addIntegratorOptions(opts);
     const auto vm = study::parse("ch8_maneuvers",
@@ -243,30 +249,60 @@ int main(int argc, char** argv) {
       strategies = splitList(vm["strategy"].as<std::string>());
       for (const auto& st : strategies) makeRearSteerStrategy(st, linear, &table);  // validates the name
     }
+    int threads = vm["threads"].as<int>();
+    if (threads < 0) throw Error("--threads must be non-negative, got " + std::to_string(threads));
+    if (threads == 0) threads = int(std::max(1u, std::thread::hardware_concurrency()));
     const std::string out = study::outputDir(vm, "ch8_maneuvers");
     const auto wall0 = std::chrono::steady_clock::now();
 
+    // The runs go through the sweep runner (vdyn/core/sweep.h): one variation per
+    // (scenario, strategy), handed out one at a time to --threads threads, each
+    // run building its own scene and Simbody system; rows come back in variation
+    // order, so the outputs do not depend on the number of threads.
+    SweepDescription sweep;
+    sweep.name = "ch8_maneuvers";
+    {
+      GridAxis byScenario{{"scenario"}, {}}, byStrategy{{"strategy"}, {}};
+      for (const Scenario& sc : scenarios) byScenario.values.push_back({sc.id});
+      for (const auto& st : strategies) byStrategy.values.push_back({st});
+      sweep.addVariations(makeGridVariations({byScenario, byStrategy}));
+    }
+    SweepOptions sweepOptions;
+    sweepOptions.threads = threads;
+    if (threads > 1 && study::interactive()) sweepOptions.progress = sweepProgressPrinter("ch8_maneuvers");
+    const SweepResult swept = runSweep(
+        sweep,
+        [&](const SweepDescription&, const Variation& v) {
+          const Scenario& sc = scenarios[v.index / strategies.size()];
+          const std::string& st = strategies[v.index % strategies.size()];
+          RunResult r = runOne(scene, sc, st, base, out, threads == 1);
+          r.summary["path"] = sc.path_json;
+          r.summary["path_peak_lateral_acceleration_m_s2"] = sc.path_peak_ay;
+          r.summary["gains"] = {{"k1_rad_per_s2_per_m", sc.gains.k1_rad_per_s2_per_m},
+                                {"k2_rad_per_s2", sc.gains.k2_rad_per_s2},
+                                {"k3_rad_per_s2_per_m", sc.gains.k3_rad_per_s2_per_m},
+                                {"k4_rad_per_s2", sc.gains.k4_rad_per_s2},
+                                {"k5_per_s", sc.gains.k5_per_s},
+                                {"look_ahead_s", sc.gains.look_ahead_s},
+                                {"acceleration_lag_s", sc.gains.acceleration_lag_s},
+                                {"g1_per_s2", sc.rear.g1_per_s2},
+                                {"g2_per_s", sc.rear.g2_per_s}};
+          return r.summary;
+        },
+        sweepOptions);
+
     Json runs = Json::array();
     int failed = 0;
+    std::size_t row = 0;
     for (const Scenario& sc : scenarios) {
       const std::string refCsv = out + "/" + sc.id + "_reference.csv";
       study::writePathCsv(refCsv, *sc.path, sc.speed_m_s * 1.0, sc.speed_m_s * 2.0);
       std::vector<std::pair<std::string, std::string>> csvs;
       for (const auto& st : strategies) {
-        RunResult r = runOne(scene, sc, st, base, out);
-        r.summary["path"] = sc.path_json;
-        r.summary["path_peak_lateral_acceleration_m_s2"] = sc.path_peak_ay;
-        r.summary["gains"] = {{"k1_rad_per_s2_per_m", sc.gains.k1_rad_per_s2_per_m},
-                              {"k2_rad_per_s2", sc.gains.k2_rad_per_s2},
-                              {"k3_rad_per_s2_per_m", sc.gains.k3_rad_per_s2_per_m},
-                              {"k4_rad_per_s2", sc.gains.k4_rad_per_s2},
-                              {"k5_per_s", sc.gains.k5_per_s},
-                              {"look_ahead_s", sc.gains.look_ahead_s},
-                              {"acceleration_lag_s", sc.gains.acceleration_lag_s},
-                              {"g1_per_s2", sc.rear.g1_per_s2},
-                              {"g2_per_s", sc.rear.g2_per_s}};
+        const SweepRow& r = swept.rows[row++];
+        if (!r.ok) throw Error(sc.id + " " + st + ": " + r.reason);  // not a failed manoeuvre: an I/O error
         if (r.summary["completed"].get<bool>()) {
-          csvs.push_back({st, r.csv});
+          csvs.push_back({st, out + "/" + sc.id + "_" + st + ".csv"});
         } else {
           ++failed;
         }
@@ -277,7 +313,7 @@ int main(int argc, char** argv) {
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     study::writeJson(out + "/summary.json",
                      {{"runs", runs}, {"kr_table", tablePath}, {"integrator", base.integrator.method},
-                      {"accuracy", base.integrator.accuracy}, {"wall_time_s", wall}});
+                      {"accuracy", base.integrator.accuracy}, {"wall_time_s", wall}, {"threads", threads}});
 
     std::printf("ch8_maneuvers: 4WS vehicle, %s at %g, Kr table %s\n", base.integrator.method.c_str(),
                 base.integrator.accuracy, tablePath.c_str());

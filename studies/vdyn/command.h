@@ -32,6 +32,7 @@ PluginRegistry& registryWithPlugins(const study::po::variables_map& vm);
 int runCommand(const std::vector<std::string>& args);
 int checkCommand(const std::vector<std::string>& args);
 int listCommand(const std::vector<std::string>& args);
+int sweepCommand(const std::vector<std::string>& args);
 
 /// The command table (main.cpp).
 const std::vector<Command>& commands();

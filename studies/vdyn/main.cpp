@@ -2,7 +2,8 @@
 //   vdyn run SCENE [--set key.path=value ...] [--out DIR] [--plugin PATH ...]
 //   vdyn check SCENE [--set ...] [--plugin PATH ...]
 //   vdyn list [KIND] [--plugin PATH ...]
-// One source file per subcommand (run.cpp, check.cpp, list.cpp), listed in the
+//   vdyn sweep SWEEP [--threads N] [--out DIR] ...; mpirun -n N vdyn sweep SWEEP --mpi
+// One source file per subcommand (run.cpp, check.cpp, list.cpp, sweep.cpp), listed in the
 // table below.
 #include <cstdio>
 #include <iostream>
@@ -22,6 +23,10 @@ const std::vector<Command>& commands() {
        "validate a scene file without running it; prints every error found", &checkCommand},
       {"list", "list [KIND] [--plugin PATH ...]",
        "every registered vehicle, plugin and analysis with its keys, units, defaults and meaning", &listCommand},
+      {"sweep", "sweep SWEEP [--threads N] [--out DIR] [--fresh] [--retry-failed] [--plugin PATH ...]; "
+                "mpirun -n N vdyn sweep SWEEP --mpi",
+       "run a scene over a sweep file's variations on threads or MPI processes; one CSV/JSON ordered by variation",
+       &sweepCommand},
   };
   return table;
 }

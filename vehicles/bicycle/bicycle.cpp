@@ -1,5 +1,7 @@
 #include "vdyn/vehicles/bicycle.h"
 
+#include "vdyn/core/threads.h"
+
 #include "vdyn/plugins/builtin.h"
 #include "vdyn/vehicles/chassis_outputs.h"
 
@@ -150,6 +152,7 @@ SimTK::State Bicycle::makeInitialState(double speed) const {
     assembler.lockMobilizer(chassis_.getMobilizedBodyIndex());
     for (auto mbx : steeringStateBodies(*scene_)) assembler.lockMobilizer(mbx);  // keep delta at its initial value
     assembler.setErrorTolerance(1e-12);
+    const auto lock = lockSimbodyAssembler();  // Simbody's Ipopt is not thread-safe (vdyn/core/threads.h)
     assembler.assemble(s);
   }
   s.updU() = 0;

@@ -1,6 +1,7 @@
 #include "vdyn/vehicles/assembly.h"
 
 #include "vdyn/core/error.h"
+#include "vdyn/core/threads.h"
 
 namespace vdyn {
 
@@ -15,6 +16,7 @@ void assembleLoops(const SimTK::MultibodySystem& system, SimTK::State& s,
   for (auto mbx : locked) assembler.lockMobilizer(mbx);
   assembler.setErrorTolerance(1e-10);
   try {
+    const auto lock = lockSimbodyAssembler();  // Simbody's Ipopt is not thread-safe (vdyn/core/threads.h)
     assembler.assemble(s);
   } catch (const std::exception& e) {
     throw Error(what + ": closing the suspension loops failed: " + e.what());

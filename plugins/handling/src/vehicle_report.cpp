@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include "vdyn/core/threads.h"
 
 namespace vdyn {
 
@@ -56,6 +57,7 @@ std::vector<KinematicsPoint> calcSuspensionKinematics(const Scene& scene, const 
     c.lower_arm.setOneQ(s, 0, theta);
     try {
       assembler.initialize(s);
+      const auto lock = lockSimbodyAssembler();  // Simbody's Ipopt is not thread-safe (vdyn/core/threads.h)
       assembler.assemble(s);
       assembler.updateFromInternalState(s);
     } catch (const std::exception& e) {

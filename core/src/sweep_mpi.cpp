@@ -1,0 +1,228 @@
+#include "vdyn/core/sweep_mpi.h"
+
+#include <atomic>
+#include <chrono>
+#include <cstdint>
+#include <cstdio>
+#include <deque>
+#include <filesystem>
+#include <mutex>
+#include <thread>
+
+#include <mpi.h>
+
+namespace vdyn {
+
+namespace {
+constexpr int kTagUp = 1;    // worker -> manager: hello or a journal line
+constexpr int kTagTask = 2;  // manager -> worker: variation index, or -1 to stop
+
+/// Waits for a request by testing and sleeping (Open MPI's blocking waits spin
+/// a core at 100 %, taking it from the runs on the same machine).
+void waitPolling(MPI_Request& req) {
+  int done = 0;
+  long sleep_us = 20;
+  for (;;) {
+    MPI_Test(&req, &done, MPI_STATUS_IGNORE);
+    if (done) return;
+    std::this_thread::sleep_for(std::chrono::microseconds(sleep_us));
+    sleep_us = std::min(sleep_us * 2, 1000L);
+  }
+}
+
+void sendTask(int rank, std::int64_t index) {
+  MPI_Request req;
+  MPI_Isend(&index, 1, MPI_INT64_T, rank, kTagTask, MPI_COMM_WORLD, &req);
+  waitPolling(req);
+}
+
+void sendUp(const std::string& text) {
+  MPI_Request req;
+  MPI_Isend(text.data(), int(text.size()), MPI_CHAR, 0, kTagUp, MPI_COMM_WORLD, &req);
+  waitPolling(req);
+}
+
+std::string hello(std::uint64_t fingerprint) { return "hello " + std::to_string(fingerprint); }
+}  // namespace
+
+MpiSession::MpiSession(int* argc, char*** argv) {
+  int provided = 0;
+  MPI_Init_thread(argc, argv, MPI_THREAD_FUNNELED, &provided);
+  if (provided < MPI_THREAD_FUNNELED) {
+    std::fprintf(stderr, "MPI library does not provide MPI_THREAD_FUNNELED\n");
+    MPI_Abort(MPI_COMM_WORLD, 1);
+  }
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank_);
+  MPI_Comm_size(MPI_COMM_WORLD, &size_);
+}
+
+MpiSession::~MpiSession() { MPI_Finalize(); }
+
+void MpiSession::abort(int code) {
+  MPI_Abort(MPI_COMM_WORLD, code);
+  std::abort();
+}
+
+SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, const SweepOptions& o) {
+  int rank = 0, size = 1;
+  MPI_Comm_rank(MPI_COMM_WORLD, &rank);
+  MPI_Comm_size(MPI_COMM_WORLD, &size);
+  if (o.threads < 0) throw Error("sweep: --threads must not be negative, got " + std::to_string(o.threads));
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = processCpuSeconds();
+  SweepResult res;
+  res.runner = "mpi";
+
+  if (rank != 0) {
+    // --- worker ------------------------------------------------------------------
+    sendUp(hello(d.fingerprint()));
+    for (;;) {
+      std::int64_t index = -1;
+      MPI_Request req;
+      MPI_Irecv(&index, 1, MPI_INT64_T, 0, kTagTask, MPI_COMM_WORLD, &req);
+      waitPolling(req);
+      if (index < 0) break;
+      if (std::size_t(index) >= d.variations.size())
+        throw Error("sweep (MPI rank " + std::to_string(rank) + "): the manager sent variation " +
+                    std::to_string(index) + " of " + std::to_string(d.variations.size()));
+      sendUp(sweepJournalLine(d, runVariation(d, d.variations[std::size_t(index)], run)));
+      ++res.ran;
+    }
+    res.workers = 1;
+    res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    res.cpu_s = processCpuSeconds() - cpu0;
+    return res;
+  }
+
+  // --- manager (rank 0) ------------------------------------------------------------
+  const int localThreads = size == 1 ? std::max(1, o.threads) : o.threads;
+  const std::size_t n = d.variations.size();
+  res.rows.resize(n);
+  std::vector<char> have(n, 0);
+  std::FILE* journal = nullptr;
+  if (!o.out_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(o.out_dir, ec);
+    if (ec) throw Error("cannot create output folder '" + o.out_dir + "': " + ec.message());
+    if (o.resume)
+      for (SweepRow& r : readSweepJournal(d, o.out_dir)) {
+        if (!r.ok && o.retry_failed) continue;
+        have[r.index] = 1;
+        res.rows[r.index] = std::move(r);
+        ++res.resumed;
+      }
+    journal = openSweepJournal(o.out_dir, o.resume);
+  }
+  std::deque<std::size_t> queue;
+  for (std::size_t i = 0; i < n; ++i)
+    if (!have[i]) queue.push_back(i);
+  const std::size_t pendingCount = queue.size();
+
+  SweepProgress prog;
+  prog.total = n;
+  prog.skipped = res.resumed;
+  auto record = [&](SweepRow&& row) {  // manager thread only
+    if (journal) {
+      const std::string line = sweepJournalLine(d, row) + "\n";
+      if (std::fwrite(line.data(), 1, line.size(), journal) != line.size() || std::fflush(journal) != 0)
+        throw Error("cannot append to '" + o.out_dir + "/runs.jsonl'");
+    }
+    ++prog.done;
+    if (!row.ok) ++prog.failed;
+    res.rows[row.index] = std::move(row);
+    prog.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    prog.eta_s = prog.elapsed_s / prog.done * double(pendingCount - prog.done);
+    if (o.progress) o.progress(prog);
+  };
+
+  std::mutex mu;  // guards queue and localDone
+  std::vector<SweepRow> localDone;
+  std::atomic<int> localRunning{localThreads};
+  auto take = [&](std::size_t& i) {
+    std::lock_guard<std::mutex> lock(mu);
+    if (queue.empty()) return false;
+    i = queue.front();
+    queue.pop_front();
+    return true;
+  };
+  auto localWorker = [&] {
+    for (std::size_t i; take(i);) {
+      SweepRow row = runVariation(d, d.variations[i], run);
+      std::lock_guard<std::mutex> lock(mu);
+      localDone.push_back(std::move(row));
+    }
+    --localRunning;
+  };
+  std::vector<std::thread> pool;
+  for (int t = 0; t < localThreads; ++t) pool.emplace_back(localWorker);
+
+  int remoteActive = size - 1;
+  long sleep_us = 20;
+  std::string buffer;
+  const std::string expected = hello(d.fingerprint());
+  try {
+    for (;;) {
+      // A local worker pushes its last row before it counts itself out, so
+      // reading the count first and then taking the rows misses none.
+      const int running = localRunning.load();
+      std::vector<SweepRow> done;
+      {
+        std::lock_guard<std::mutex> lock(mu);
+        done.swap(localDone);
+      }
+      for (auto& row : done) record(std::move(row));
+      if (remoteActive == 0 && running == 0) break;
+      int flag = 0;
+      MPI_Status st;
+      if (remoteActive > 0) MPI_Iprobe(MPI_ANY_SOURCE, kTagUp, MPI_COMM_WORLD, &flag, &st);
+      if (!flag) {
+        if (done.empty()) {
+          std::this_thread::sleep_for(std::chrono::microseconds(sleep_us));
+          sleep_us = std::min(sleep_us * 2, 500L);
+        }
+        continue;
+      }
+      sleep_us = 20;
+      int count = 0;
+      MPI_Get_count(&st, MPI_CHAR, &count);
+      buffer.assign(std::size_t(count), '\0');
+      MPI_Recv(buffer.data(), count, MPI_CHAR, st.MPI_SOURCE, kTagUp, MPI_COMM_WORLD, MPI_STATUS_IGNORE);
+      const std::string where = "sweep: MPI rank " + std::to_string(st.MPI_SOURCE);
+      if (buffer.rfind("hello ", 0) == 0) {
+        if (buffer != expected)
+          throw Error(where + " read a different sweep (fingerprint " + buffer.substr(6) + ", rank 0: " +
+                      expected.substr(6) + "): do all machines see the same sweep and scene files?");
+      } else {
+        record(parseSweepJournalLine(d, buffer, where));
+      }
+      std::size_t i;
+      if (take(i)) {
+        sendTask(st.MPI_SOURCE, std::int64_t(i));
+      } else {
+        sendTask(st.MPI_SOURCE, -1);
+        --remoteActive;
+      }
+    }
+  } catch (...) {
+    {
+      std::lock_guard<std::mutex> lock(mu);
+      queue.clear();
+    }
+    for (auto& t : pool) t.join();
+    if (journal) std::fclose(journal);
+    throw;
+  }
+  for (auto& t : pool) t.join();
+  if (journal) std::fclose(journal);
+  if (pendingCount == 0 && o.progress) o.progress(prog);
+  res.workers = localThreads + size - 1;
+  res.ran = prog.done;
+  for (const auto& r : res.rows)
+    if (!r.ok) ++res.failed;
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  res.cpu_s = processCpuSeconds() - cpu0;
+  if (!o.out_dir.empty()) writeSweepOutputs(d, res, o.out_dir);
+  return res;
+}
+
+}  // namespace vdyn

@@ -1,0 +1,209 @@
+// vdyn sweep SWEEP: run a scene over the variations of a sweep file
+// (vdyn/core/sweep.h) on threads or MPI processes, and gather one table.
+//   vdyn sweep SWEEP [--threads N] [--out DIR] [--fresh] [--retry-failed]
+//   mpirun -n N vdyn sweep SWEEP --mpi
+// Each run is the scene file with the sweep's "set" and the variation's
+// settings applied as --set overrides (scene_file.h), built and run in its
+// own Simbody system; its summary JSON gives the collected columns. Results:
+// <out>/results.csv and results.json (ordered by variation, identical for any
+// number of threads or ranks), runs.jsonl (the journal a resumed sweep skips),
+// sweep_stats.json (times), and the sweep file's plots (PNG + .gp script).
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <thread>
+
+#include "command.h"
+#include "vdyn/core/scene_file.h"
+#include "vdyn/core/sweep.h"
+#ifdef VDYN_HAVE_MPI
+#include "vdyn/core/sweep_mpi.h"
+#endif
+
+namespace vdyn::cli {
+
+namespace {
+
+std::vector<Override> toOverrides(const std::vector<SweepSetting>& settings) {
+  std::vector<Override> o;
+  for (const auto& s : settings) o.push_back(Override{s.key, s.value});
+  return o;
+}
+
+std::string gpQuote(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+std::string lastSegment(const std::string& path) {
+  const auto p = path.find_last_of('.');
+  return p == std::string::npos ? path : path.substr(p + 1);
+}
+
+/// Renders the sweep file's plots from results.csv with gnuplot (script kept as <png>.gp).
+void renderPlots(const SweepDescription& d, const SweepResult& r, const std::string& dir) {
+  if (d.plots.empty()) return;
+  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
+    throw Error("gnuplot not found: the sweep's plots need it (apt-get install gnuplot-nox)");
+  const std::string csv = dir + "/results.csv";
+  auto distinct = [&](const std::string& column) {
+    std::vector<std::string> v;
+    if (column.empty()) return std::vector<std::string>{""};
+    const auto k = std::find(d.keys.begin(), d.keys.end(), column);
+    for (const SweepRow& row : r.rows) {
+      std::string text;
+      if (k != d.keys.end()) {
+        const Json* x = d.variations[row.index].find(column);
+        text = x ? formatSweepField(*x) : "";
+      } else {
+        const auto c = std::find(d.collect.begin(), d.collect.end(), column) - d.collect.begin();
+        text = row.ok ? formatSweepField(row.values[std::size_t(c)]) : "";
+      }
+      if (!text.empty() && std::find(v.begin(), v.end(), text) == v.end()) v.push_back(text);
+    }
+    return v;
+  };
+  for (const SweepPlot& p : d.plots) {
+    const std::string png = dir + "/" + p.png, script = png + ".gp";
+    const auto panels = distinct(p.panels), series = distinct(p.series);
+    const int cols = int(std::ceil(std::sqrt(double(panels.size()))));
+    const int rows = int((panels.size() + cols - 1) / cols);
+    std::ofstream g(script);
+    if (!g) throw Error("cannot write '" + script + "'");
+    g << "set terminal pngcairo size " << 640 * cols << "," << 480 * rows + 40 << " font 'sans,9'\n"
+      << "set output " << gpQuote(png) << "\nset datafile separator ','\nset grid\nset key noenhanced\n"
+      << "set xlabel " << gpQuote(p.x_label.empty() ? p.x : p.x_label) << " noenhanced\n"
+      << "set ylabel " << gpQuote(p.y_label.empty() ? p.y : p.y_label) << " noenhanced\n";
+    if (panels.size() > 1 || !p.title.empty())
+      g << "set multiplot layout " << rows << "," << cols << " title " << gpQuote(p.title) << " noenhanced\n";
+    for (const std::string& panel : panels) {
+      if (!p.panels.empty())
+        g << "set title " << gpQuote((p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel)
+          << " noenhanced\n";
+      g << "plot ";
+      bool first = true;
+      for (const std::string& s : series) {
+        std::string cond = "strcol(\"status\") eq \"ok\"";
+        if (!p.panels.empty()) cond += " && strcol(" + gpQuote(p.panels) + ") eq " + gpQuote(panel);
+        if (!p.series.empty()) cond += " && strcol(" + gpQuote(p.series) + ") eq " + gpQuote(s);
+        g << (first ? "" : ", \\\n     ") << gpQuote(csv) << " using (column(" << gpQuote(p.x) << ")*" << formatValue(p.x_scale)
+          << "):((" << cond << ") ? column(" << gpQuote(p.y) << ")*" << formatValue(p.y_scale)
+          << " : NaN) with linespoints lw 2 pt 7 ps 0.6 title "
+          << gpQuote(p.series.empty() ? lastSegment(p.y)
+                                      : (p.series_label.empty() ? lastSegment(p.series) : p.series_label) + " = " + s);
+        first = false;
+      }
+      g << "\n";
+    }
+    if (panels.size() > 1 || !p.title.empty()) g << "unset multiplot\n";
+    g.close();
+    const std::string cmd = "gnuplot " + gpQuote(script) + " 2> " + gpQuote(png + ".log");
+    if (std::system(cmd.c_str()) != 0) {
+      std::ifstream log(png + ".log");
+      std::string line, last;
+      while (std::getline(log, line))
+        if (!line.empty()) last = line;
+      throw Error("gnuplot failed on '" + script + "': " + last);
+    }
+    std::remove((png + ".log").c_str());
+  }
+}
+
+}  // namespace
+
+int sweepCommand(const std::vector<std::string>& args) {
+  namespace po = study::po;
+  po::options_description opts("Options");
+  opts.add_options()("sweep", po::value<std::string>(), "sweep file (JSON; see the README's \"Sweeps\")")(
+      "threads", po::value<int>(),
+      "worker threads (default: one per core; with --mpi: threads on rank 0 besides managing, default 1, "
+      "0 = rank 0 only manages)")(
+      "mpi", "run over MPI processes (start with mpirun -n N): rank 0 hands out variations one at a time")(
+      "out", po::value<std::string>(), "output folder (default: the sweep file's \"output\", else ./results/sweeps/<name>)")(
+      "fresh", "ignore and overwrite the journal of an earlier run (default: resume, skipping runs already done)")(
+      "retry-failed", "when resuming, run the failed variations again")(
+      "run-files", "also write each run's files (summary.json, tables) to <out>/runs/<variation>/")(
+      "no-plots", "skip the sweep file's plots")("quiet", "no progress lines");
+  addCommonOptions(opts);
+  po::variables_map vm;
+  if (!parseArgs(command("sweep"), args, opts, {"sweep"}, vm)) return 0;
+  if (!vm.count("sweep")) throw Error("bad command line: no sweep file given (vdyn sweep SWEEP)");
+  const bool useMpi = vm.count("mpi") > 0;
+#ifndef VDYN_HAVE_MPI
+  if (useMpi) throw Error("--mpi: this vdyn was built without MPI (install libopenmpi-dev and rebuild)");
+#endif
+
+  // Everything a run needs is loaded and checked before any run (and before
+  // threads start: plugin libraries change the registry).
+  const SweepDescription sweep = SweepDescription::fromFile(vm["sweep"].as<std::string>());
+  PluginRegistry& registry = registryWithPlugins(vm);
+  const SceneDescription base = SceneDescription::fromFile(sweep.scene, registry, toOverrides(sweep.common));
+  loadSceneLibraries(base, registry);
+  {
+    // A misspelt key path would fail every run: the first variation is checked
+    // the way build() checks a scene (strict keys), and stops the sweep.
+    const auto errors = base.withOverrides(toOverrides(sweep.variations.at(0).settings)).check();
+    if (!errors.empty())
+      throw Error(sweep.file + ": variation 0 (" + sweep.variations[0].id() + "): " + errors.front());
+  }
+  const std::string out = vm.count("out") ? vm["out"].as<std::string>()
+                          : !sweep.output.empty() ? sweep.output
+                                                  : "results/sweeps/" + sweep.name;
+  const bool runFiles = vm.count("run-files") > 0;
+  const SweepRunFunction run = [&](const SweepDescription&, const Variation& v) {
+    RunOptions ro;
+    if (runFiles) ro.out_dir = out + "/runs/" + std::to_string(v.index);
+    return runScene(base.withOverrides(toOverrides(v.settings)), ro);
+  };
+
+  SweepOptions so;
+  so.out_dir = out;
+  so.resume = vm.count("fresh") == 0;
+  so.retry_failed = vm.count("retry-failed") > 0;
+  const bool quiet = vm.count("quiet") > 0;
+  SweepResult r;
+  bool manager = true;
+  if (useMpi) {
+#ifdef VDYN_HAVE_MPI
+    int argc = 0;
+    char** argv = nullptr;
+    MpiSession mpi(&argc, &argv);
+    manager = mpi.rank() == 0;
+    so.threads = vm.count("threads") ? vm["threads"].as<int>() : 1;
+    if (manager && !quiet) so.progress = sweepProgressPrinter("vdyn sweep");
+    try {
+      r = runSweepMpi(sweep, run, so);
+      if (manager && !vm.count("no-plots")) renderPlots(sweep, r, out);
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "vdyn sweep: error (MPI rank %d): %s\n", mpi.rank(), e.what());
+      if (mpi.size() > 1) MpiSession::abort(1);  // the other ranks would wait for it forever
+      throw;
+    }
+#endif
+  } else {
+    so.threads = vm.count("threads") ? vm["threads"].as<int>() : int(std::max(1u, std::thread::hardware_concurrency()));
+    if (!quiet) so.progress = sweepProgressPrinter("vdyn sweep");
+    r = runSweep(sweep, run, so);
+    if (!vm.count("no-plots")) renderPlots(sweep, r, out);
+  }
+  if (!manager) return 0;
+  std::printf("vdyn sweep: %s: %zu variations, %zu run now (%zu from the journal), %zu failed; %.2f s wall, %.2f s CPU, "
+              "%d %s\n",
+              sweep.name.c_str(), sweep.variations.size(), r.ran, r.resumed, r.failed, r.wall_s, r.cpu_s, r.workers,
+              r.runner == "mpi" ? "MPI workers" : "threads");
+  std::printf("  %s/results.csv, results.json, sweep_stats.json%s\n", out.c_str(),
+              sweep.plots.empty() || vm.count("no-plots") ? "" : ", plots");
+  int shown = 0;
+  for (const SweepRow& row : r.rows)
+    if (!row.ok && shown++ < 5) std::printf("  variation %zu failed: %s\n", row.index, row.reason.c_str());
+  return 0;
+}
+
+}  // namespace vdyn::cli
