@@ -1,8 +1,11 @@
 // Run time against error for the chapter 3 transient of the 4WS vehicle
-// (ch3_transient's manoeuvre), for both corner models (constrained: the loops
-// and steering closed by constraint rows; reduced: the loops solved in the
-// knuckle's mobilizer), each integrator at accuracies 1e-3 .. 1e-8 against a
-// reference at 1e-10 of the same model.
+// (ch3_transient's manoeuvre), for three models (constrained: the loops and
+// steering closed by constraint rows; reduced: the loops solved in the
+// knuckle's mobilizer, its arm, steering and speed rows solved by Simbody;
+// dense: the reduced model with those rows solved as one dense system,
+// FourWsVehicle::useDenseRows), each integrator at accuracies 1e-3 .. 1e-8
+// against a reference at 1e-10 of the same model (the dense model's errors
+// against the reduced model's reference, which Simbody projects).
 //
 // Per run: steps, forward-dynamics evaluations (integrator realizations), CPU
 // time (std::clock: this process's CPU, not wall time), real-time factor
