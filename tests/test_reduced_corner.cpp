@@ -271,6 +271,7 @@ TEST(ReducedDense, SameAccelerationsAsSimbodysRowsInTheSameState) {
   sys.realize(s, SimTK::Stage::Acceleration);
   sys.realize(d, SimTK::Stage::Acceleration);
   EXPECT_EQ(d.getNUDotErr(), 0);  // Simbody solves no row in the dense state
+  EXPECT_EQ(red->degreesOfFreedom(d), red->degreesOfFreedom(s));
   const auto [perr, verr] = red->denseRows()->calcRowErrors(d);
   EXPECT_LT(perr, 1e-12);
   EXPECT_LT(verr, 1e-10);

@@ -130,7 +130,8 @@ double FourWsVehicle::totalMass() const {
 int FourWsVehicle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
   // A state-driven steering plugin's steer body moves by a prescribed acceleration.
-  return s.getNU() - s.getNUDotErr() - static_cast<int>(steeringStateBodies(*scene_).size());
+  const int denseRows = dense_ && dense_->isActive(s) ? dense_->numRows() : 0;  // rows Simbody does not see
+  return s.getNU() - s.getNUDotErr() - denseRows - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
 SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* report) const {
