@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
         "repeats", po::value<int>()->default_value(5), "runs of each model at the data file's setting (medians)")(
         "cost-evaluations", po::value<int>()->default_value(300), "evaluations timed for the cost per evaluation")(
         "skip-sweep", "only the references, the cost per evaluation and the headline runs")(
-        "dense-accuracy", po::value<double>()->default_value(3e-7),
+        "dense-accuracy", po::value<double>()->default_value(1e-6),
         "accuracy of the dense model's headline runs (its integrator is the data file's): the loosest of the "
         "sweep that keeps the yaw-rate history within 1e-6; the other models run at the data file's")(
         "report-interval-s", po::value<double>()->default_value(0.05), "sampling interval of the histories, s")(

@@ -49,7 +49,7 @@ class SpeedHoldPlugin;
 
 class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
  public:
-  static constexpr double kBaumgarteRate_per_s = 20.0;
+  static constexpr double kBaumgarteRate_per_s = 50.0;
 
   ReducedDenseRows(const SimTK::SimbodyMatterSubsystem& matter, const SimTK::GeneralForceSubsystem& forces)
       : matter_(&matter), forces_(&forces) {}
