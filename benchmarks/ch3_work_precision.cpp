@@ -30,7 +30,6 @@
 #include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
-#include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/fourws.h"
 
 using namespace vdyn;
@@ -45,24 +44,28 @@ struct Run {
   double perr = 0, verr = 0;  ///< dense model: its rows' largest errors at the end
 };
 
-/// The vehicle of `model` and its initial state (the constrained model's, mapped for the reduced one).
+/// The scene of `model` (composed from the scene file, like ch3_transient),
+/// its vehicle and its initial state (the constrained model's, mapped for the
+/// reduced one).
 struct Setup {
-  std::unique_ptr<FourWsVehicle> car;
+  BuiltScene built;
+  FourWsVehicle* car = nullptr;  // built's vehicle
   SimTK::State initial;
 };
 
 Setup makeSetup(const study::Ch3Case& ch3, const std::string& model) {
   Setup st;
-  auto con = ch3.buildVehicle("constrained");
-  SimTK::State s0 = con->makeInitialState(ch3.speed_m_s);
+  BuiltScene con = ch3.build("constrained");
+  SimTK::State s0 = con.makeInitialState();
   if (model == "constrained") {
-    st.car = std::move(con);
+    st.built = std::move(con);
     st.initial = s0;
   } else {  // "reduced", or "dense": the reduced model with its rows solved densely
-    st.car = ch3.buildVehicle("reduced");
-    st.initial = st.car->makeStateLike(*con, s0);
-    if (model == "dense") st.car->useDenseRows(st.initial);
+    st.built = ch3.build("reduced");
+    st.initial = st.built.vehicleAs<FourWsVehicle>().makeStateLike(con.vehicleAs<FourWsVehicle>(), s0);
   }
+  st.car = &st.built.vehicleAs<FourWsVehicle>();
+  if (model == "dense") st.car->useDenseRows(st.initial);
   st.car->getScene().getSystem().realize(st.initial, SimTK::Stage::Velocity);
   return st;
 }

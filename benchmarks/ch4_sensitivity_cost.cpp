@@ -11,7 +11,9 @@
 
 #include "bench_util.h"
 #include "study.h"
+#include "vdyn/core/scene_file.h"
 #include "vdyn/sensitivity/sensitivity.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/vehicles/vehicle_designs.h"
 
 using namespace vdyn;
@@ -36,9 +38,14 @@ int main(int argc, char** argv) {
     const ParamReader relax = data.child("tire_relaxation");
     bool relaxation = relax.boolean("enabled");
     if (vm.count("tire-relaxation")) relaxation = vm["tire-relaxation"].as<std::string>() == "on";
-    QuarterCarParams qp = QuarterCarParams::fromFile(data.string("vehicle_data"));
-    qp.tire.relaxation_length_longitudinal_m = relaxation ? relax.number("longitudinal_m") : 0.0;
-    qp.tire.relaxation_length_lateral_m = relaxation ? relax.number("lateral_m") : 0.0;
+    // The study's scene (one composition) with the tire variant; the design
+    // model with every quarter-car parameter (20) takes its vehicle's data.
+    const SceneDescription scene = SceneDescription::fromFile(
+        data.string("scene"), standardRegistry(),
+        {{"vehicle.overrides.tire.params.relaxation_length_longitudinal_m",
+          relaxation ? relax.number("longitudinal_m") : 0.0},
+         {"vehicle.overrides.tire.params.relaxation_length_lateral_m", relaxation ? relax.number("lateral_m") : 0.0}});
+    const QuarterCarParams qp = scene.build().vehicleAs<QuarterCar>().params();
     SensitivitySettings refSet;
     refSet.reference_accuracy = data.child("reference").number("accuracy");
     refSet.reference_perturbation = data.child("reference").number("perturbation");

@@ -93,6 +93,8 @@ struct Measured {
   int workers = 0;
   std::size_t runs = 0, failed = 0;
   double tail_bound = 0;   ///< threads: sum of run times / longest run (the most any N can give)
+  double run_cpu_sum = 0;  ///< threads: CPU time of all runs, s (median): the work W
+  double run_cpu_max = 0;  ///< threads: CPU time of the costliest run, s (median)
   std::string csv;
 };
 
@@ -102,11 +104,20 @@ struct Config {
   int rank0Threads = 1;  ///< MPI: worker threads on rank 0 (0 = manager only)
 };
 
-Measured measure(const Config& c, const std::string& workload, int runs, double tMin, double tMax, int repeats,
-                 const std::string& outRoot) {
-  std::vector<double> wall, launch, cpu, over, load;
-  Measured m;
-  for (int r = 0; r < repeats; ++r) {
+// Every configuration once per repeat, in turn (c1 c2 c3 c4 c1 c2 ...), so a
+// change of the machine's other load affects all configurations alike.
+std::vector<Measured> measure(const std::vector<Config>& configs, const std::string& workload, int runs, double tMin,
+                              double tMax, int repeats, const std::string& outRoot) {
+  struct Samples {
+    std::vector<double> wall, launch, cpu, over, load, runCpuSum, runCpuMax;
+  };
+  std::vector<Samples> samples(configs.size());
+  std::vector<Measured> ms(configs.size());
+  for (int r = 0; r < repeats; ++r)
+  for (std::size_t ci = 0; ci < configs.size(); ++ci) {
+    const Config& c = configs[ci];
+    Measured& m = ms[ci];
+    auto& [wall, launch, cpu, over, load, runCpuSum, runCpuMax] = samples[ci];
     const std::string dir = outRoot + "/" + workload + "_" + c.label + std::to_string(c.count) + "_" +
                             std::to_string(c.rank0Threads);
     std::filesystem::remove_all(dir);
@@ -123,6 +134,10 @@ Measured measure(const Config& c, const std::string& workload, int runs, double 
       double sum = 0, longest = 0;
       for (const SweepRow& row : res.rows) sum += row.wall_s, longest = std::max(longest, row.wall_s);
       m.tail_bound = longest > 0 ? sum / longest : 0;
+      double cpuSum = 0, cpuMax = 0;
+      for (const SweepRow& row : res.rows) cpuSum += row.cpu_s, cpuMax = std::max(cpuMax, row.cpu_s);
+      runCpuSum.push_back(cpuSum);
+      runCpuMax.push_back(cpuMax);
     } else {
       char cmd[4096];
       std::snprintf(cmd, sizeof cmd,
@@ -148,12 +163,17 @@ Measured measure(const Config& c, const std::string& workload, int runs, double 
     m.failed = stats["failed"].get<std::size_t>();
     m.csv = readFile(dir + "/results.csv");
   }
+  for (std::size_t ci = 0; ci < configs.size(); ++ci) {
+  Measured& m = ms[ci];
+  const auto& [wall, launch, cpu, over, load, runCpuSum, runCpuMax] = samples[ci];
   m.wall_s = bench::median(wall);
   m.launch_s = launch.empty() ? 0 : bench::median(launch);
   m.cpu_s = bench::median(cpu);
   m.overhead_ms = bench::median(over);
   m.load = bench::median(load);
-  return m;
+  if (!runCpuSum.empty()) m.run_cpu_sum = bench::median(runCpuSum), m.run_cpu_max = bench::median(runCpuMax);
+  }
+  return ms;
 }
 
 int child(const study::po::variables_map& vm) {
@@ -224,7 +244,7 @@ int main(int argc, char** argv) {
     std::vector<Config> configs = {{"threads", 1, 1}, {"threads", 2, 1}};
     if (mpi) configs.insert(configs.end(), {{"mpi", 1, 1}, {"mpi", 2, 1}});
     std::vector<Measured> ms;
-    for (const Config& c : configs) ms.push_back(measure(c, "ch3", runs, tMin, tMax, repeats, out));
+    ms = measure(configs, "ch3", runs, tMin, tMax, repeats, out);
 
     std::printf("\n  ch3 sweep            workers   wall s  speed-up   CPU s  CPU/CPU1  CPU/wall  idle+runner ms/run  "
                 "load(1 min)  runs\n");
@@ -249,11 +269,14 @@ int main(int argc, char** argv) {
     if (mpi) nullConfigs.insert(nullConfigs.end(), {{"mpi", 2, 0}, {"mpi", 2, 1}});
     std::printf("\n  empty runs (%d): runner overhead  wall s   ms/run (wall / runs; MPI manager-only: one message\n"
                 "  round trip per run, test-and-sleep waits)\n", nullRuns);
-    double serialMsPerRun = 0;
-    for (const Config& c : nullConfigs) {
-      const Measured m = measure(c, "null", nullRuns, 0, 1, repeats, out);
+    double serialMsPerRun = 0, mpiMsPerRun = 0;
+    const std::vector<Measured> nullMs = measure(nullConfigs, "null", nullRuns, 0, 1, repeats, out);
+    for (std::size_t ci = 0; ci < nullConfigs.size(); ++ci) {
+      const Config& c = nullConfigs[ci];
+      const Measured& m = nullMs[ci];
       const double msPerRun = 1e3 * m.wall_s / double(nullRuns);
       if (c.label == "threads" && c.count == 1) serialMsPerRun = msPerRun;
+      if (c.label == "mpi" && c.rank0Threads == 0) mpiMsPerRun = msPerRun;
       std::printf("  %-33s %7.3f %8.4f\n",
                   (c.label == "threads" ? "threads " + std::to_string(c.count)
                                         : "MPI " + std::to_string(c.count) + " processes, rank 0 " +
@@ -279,6 +302,26 @@ int main(int argc, char** argv) {
                 ms[0].tail_bound, runs);
     std::printf("\n  (the runner's own f bounds what the runner costs; the measured f also holds the machine's\n"
                 "   other load, memory bandwidth shared by the runs and the tail: the last run alone on a core)\n");
+
+    // --- prediction from CPU times (independent of the machine's other load) ------
+    // Work W = CPU time of all runs, t_max = the costliest run (CPU), n runs, o =
+    // runner time per run (threads: serial, under the journal lock; MPI: one
+    // round trip per run, a latency each worker pays). Greedy hand-out one run
+    // at a time (list scheduling, Graham 1969) on N cores finishes within
+    //   max(W/N, t_max) <= T_N <= W/N + (1 - 1/N) t_max,  plus n o (threads) or n o / N (MPI).
+    const double W = ms[0].run_cpu_sum, tmax = ms[0].run_cpu_max, n = runs;
+    std::printf("\n  prediction from CPU times (load-independent): W = %.3f s CPU in %d runs (mean %.1f ms), "
+                "longest run %.3f s\n", W, runs, 1e3 * W / n, tmax);
+    std::printf("  runner per run o: threads %.4f ms (serial), MPI %.4f ms (round trip per worker)\n", serialMsPerRun,
+                mpiMsPerRun);
+    std::printf("     N     this sweep: S = W / T_N (Graham bounds)     many runs of this mean cost: S = N / (1 + N f)\n");
+    const double fT = serialMsPerRun * 1e-3 / (W / n), fM = mpiMsPerRun * 1e-3 / (W / n);
+    for (int N : {1, 2, 4, 8, 16, 64}) {
+      const double lo = std::max(W / N, tmax) + n * serialMsPerRun * 1e-3;
+      const double hi = W / N + (1 - 1.0 / N) * tmax + n * serialMsPerRun * 1e-3;
+      std::printf("  %4d     threads %5.2f .. %5.2f                      threads %6.2f (f %.1e), MPI %6.2f (%.1e)\n",
+                  N, W / hi, W / lo, N / (1 + N * fT), fT, N / (1 + fM), fM);
+    }
     std::printf("  output: %s\n", out.c_str());
     if (!identical) throw Error("results.csv differs between configurations");
   });

@@ -11,7 +11,8 @@
 #include "test_util.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/sensitivity/sensitivity.h"
-#include "vdyn/vehicles/vehicle_designs.h"
+#include "vdyn/analyses/analyses.h"
+#include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/vehicles/fourws.h"
@@ -240,7 +241,9 @@ TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
   const char* models[2] = {"constrained", "reduced"};
   for (int m = 0; m < 2; ++m) {
     SensitivityProblem p;
-    p.model = std::make_shared<FourWsDesign>(params(models[m], "appendix_a_relaxation.json"), FourWsManoeuvre{});
+    p.model = SceneDesign::fromAnalysis(SceneDescription::fromFile(
+        "scenes/ch4_sensitivity_fourws.json", standardRegistry(),
+        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.corner_model", models[m]}}));
     p.parameters = {"front.spring.stiffness_N_per_m"};
     p.cost = CostFunctional::parse("integral_of_square:chassis.roll_rate_rad_s");
     p.t_end_s = 1.0;

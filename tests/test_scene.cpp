@@ -11,7 +11,11 @@
 #include "vdyn/forces/body_force.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/speed/speed_hold.h"
+#include "vdyn/rear_steer/rear_steer.h"
+#include "vdyn/sensitivity/sensitivity.h"
+#include "vdyn/steering/steering.h"
 #include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/quarter_car.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
@@ -231,6 +235,68 @@ TEST(PluginLibrary, NamedErrors) {
   EXPECT_TRUE(contains(abi, "built for plugin ABI version " + std::to_string(VDYN_PLUGIN_ABI_VERSION + 100) +
                                 ", this vdyn has version " + std::to_string(VDYN_PLUGIN_ABI_VERSION)))
       << abi;
+}
+
+// Choices inside plugins and analyses are registered names: a steering command
+// registered the way a plugin library does (addChoice) is found by the steering
+// plugin of a scene built from that registry; the families are listed; errors
+// name the family, the type and the known ones.
+namespace {
+class ConstCommand : public SteeringCommand {
+ public:
+  explicit ConstCommand(double a) : a_(a) {}
+
+ protected:
+  SteerCommandValue DoCalc(double) const override { return {a_, 0, 0}; }
+
+ private:
+  double a_;
+};
+}  // namespace
+
+TEST(Registry, ChoicesAreRegisteredNamesThatPluginsOfASceneFind) {
+  PluginRegistry r = makeStandardRegistry();
+  r.addChoice<SteeringCommand>(
+      "steering_command", "fixture_const",
+      [](const ParamReader& p, const NoContext&) { return std::make_unique<ConstCommand>(p.number("angle_rad")); },
+      {"test: a constant angle", {{"angle_rad", "rad", "required", "angle"}}});
+  Json j = smallScene().json();
+  j["plugins"][0]["command"] = R"({"type": "fixture_const", "angle_rad": 0.03})"_json;
+  const BuiltScene b = SceneDescription::fromJson(j, "small.json", r).build();
+  const SimTK::State s = b.makeInitialState();
+  EXPECT_EQ(b.scene().evalOutput("front_steer.command_rad", s), 0.03);
+  EXPECT_NEAR(b.scene().evalOutput("front_steer.angle_rad", s), 0.03, 1e-9);  // the knuckles follow it
+  // Not in the standard registry: the same scene names an unknown command.
+  const std::string unknown = errorOf([&] { SceneDescription::fromJson(j, "small.json", standardRegistry()).build(); });
+  EXPECT_TRUE(contains(unknown, "small.json") &&
+              contains(unknown, "unknown steering command 'fixture_const'; known: hold, smooth_step, steps"))
+      << unknown;
+  EXPECT_EQ(r.choiceFamilies(),
+            (std::vector<std::string>{"rear_steer_strategy", "sensitivity_method", "steering_command"}));
+  EXPECT_EQ(r.knownChoices("sensitivity_method"),
+            (std::vector<std::string>{"fd_central", "fd_forward", "mixed", "reference"}));
+  EXPECT_EQ(r.choiceInfo("steering_command", "smooth_step").fields.at(1).key, "final_rad");
+  EXPECT_EQ(errorOf([&] {
+              r.addChoice<SteeringCommand>(
+                  "steering_command", "hold",
+                  [](const ParamReader&, const NoContext&) { return std::make_unique<ConstCommand>(0); }, {});
+            }),
+            "steering command 'hold' is already registered");
+  EXPECT_EQ(errorOf([&] {
+              r.addChoice<RearSteerStrategy, RearSteerContext>(
+                  "steering_command", "x",
+                  [](const ParamReader&, const RearSteerContext&) { return std::make_unique<TwoWsStrategy>(); }, {});
+            }),
+            "steering command 'x': the family was registered with another interface");
+  EXPECT_EQ(makeRearSteerStrategy("2ws", LinearBicycleParams{}, nullptr, &r)->name(), "2ws");
+  EXPECT_EQ(makeSensitivityMethod("mixed", {}, &r)->name(), "mixed");
+}
+
+// The concrete vehicle of a built scene, for code that needs its own API.
+TEST(SceneFile, VehicleAsGivesTheConcreteVehicleOrANamedError) {
+  BuiltScene b = smallScene().build();
+  EXPECT_EQ(&b.vehicleAs<FourWsVehicle>().getScene(), &b.scene());
+  EXPECT_EQ(errorOf([&] { b.vehicleAs<QuarterCar>(); }), "vehicle 'fourws' is not a vdyn::QuarterCar");
 }
 
 // body_force: the rise, hold and fall of its scale (closed form).

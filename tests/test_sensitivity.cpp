@@ -274,7 +274,7 @@ TEST(Sensitivity, UserErrorsNameTheCause) {
   EXPECT_EQ(test::errorOf([&] { p.validate(); }),
             "sensitivity problem: design parameter 'mass_kg' is listed twice");
   EXPECT_EQ(test::errorOf([] { makeSensitivityMethod("adjoint"); }),
-            "unknown sensitivity method 'adjoint'; known: fd_forward, fd_central, mixed, reference");
+            "unknown sensitivity method 'adjoint'; known: fd_central, fd_forward, mixed, reference");
   EXPECT_EQ(test::errorOf([] { CostFunctional::parse("mean:x_m"); }),
             "unknown cost kind 'mean'; known: integral_of_square, maximum, final_value");
   EXPECT_EQ(test::errorOf([&] { p.model->build({1.0, NAN, 4.0}); }),

@@ -1,6 +1,9 @@
 #include "vdyn/core/scene.h"
 
 #include <algorithm>
+#include <cstdlib>
+
+#include <cxxabi.h>
 
 #include "vdyn/core/registry.h"
 
@@ -75,9 +78,73 @@ void PluginRegistry::addVehicle(const std::string& type, VehicleFactory factory,
 
 void PluginRegistry::addAnalysis(const std::string& type, AnalysisFactory factory, TypeInfo info) {
   if (!factory) throw Error("analysis factory for '" + type + "' is empty");
+  addAnalysis(
+      type, [f = std::move(factory)](const ParamReader& settings, const PluginRegistry&) { return f(settings); },
+      std::move(info));
+}
+
+void PluginRegistry::addAnalysis(const std::string& type, AnalysisFactoryWithRegistry factory, TypeInfo info) {
+  if (!factory) throw Error("analysis factory for '" + type + "' is empty");
   requireNew(PluginKind::Analysis, type);
   analyses_.emplace(type, std::move(factory));
   infos_[{PluginKind::Analysis, type}] = std::move(info);
+}
+
+namespace {
+std::string familyText(std::string family) {
+  for (char& c : family)
+    if (c == '_') c = ' ';
+  return family;
+}
+}  // namespace
+
+void PluginRegistry::addChoiceErased(const std::string& family, const std::string& type, const std::string& signature,
+                                     std::shared_ptr<const void> factory, TypeInfo info) {
+  if (family.empty() || type.empty()) throw Error("choice family and type names must not be empty");
+  auto fs = familySignatures_.find(family);
+  if (fs != familySignatures_.end() && fs->second != signature)
+    throw Error(familyText(family) + " '" + type + "': the family was registered with another interface");
+  if (hasChoice(family, type)) throw Error(familyText(family) + " '" + type + "' is already registered");
+  familySignatures_[family] = signature;
+  choices_[{family, type}] = Choice{signature, std::move(factory), std::move(info)};
+}
+
+const void* PluginRegistry::choiceFactory(const std::string& family, const std::string& type,
+                                          const std::string& signature, const std::string& where) const {
+  auto it = choices_.find({family, type});
+  if (it == choices_.end()) {
+    std::string list;
+    for (const auto& n : knownChoices(family)) list += (list.empty() ? "" : ", ") + n;
+    throw Error((where.empty() ? "" : where + ": ") + "unknown " + familyText(family) + " '" + type +
+                "'; known: " + (list.empty() ? "(none)" : list));
+  }
+  if (it->second.signature != signature)
+    throw Error((where.empty() ? "" : where + ": ") + familyText(family) + " '" + type +
+                "' was registered with another interface");
+  return it->second.factory.get();
+}
+
+bool PluginRegistry::hasChoice(const std::string& family, const std::string& type) const {
+  return choices_.count({family, type}) != 0;
+}
+
+std::vector<std::string> PluginRegistry::choiceFamilies() const {
+  std::vector<std::string> f;
+  for (const auto& kv : familySignatures_) f.push_back(kv.first);
+  return f;
+}
+
+std::vector<std::string> PluginRegistry::knownChoices(const std::string& family) const {
+  std::vector<std::string> names;
+  for (const auto& kv : choices_)
+    if (kv.first.first == family) names.push_back(kv.first.second);
+  return names;
+}
+
+const TypeInfo& PluginRegistry::choiceInfo(const std::string& family, const std::string& type) const {
+  static const TypeInfo none;
+  auto it = choices_.find({family, type});
+  return it == choices_.end() ? none : it->second.info;
 }
 
 bool PluginRegistry::has(PluginKind kind, const std::string& type) const {
@@ -133,7 +200,7 @@ std::unique_ptr<Analysis> PluginRegistry::createAnalysis(const std::string& type
                                                          const std::string& where) const {
   auto it = analyses_.find(type);
   if (it == analyses_.end()) unknown(PluginKind::Analysis, type, where);
-  auto a = it->second(settings);
+  auto a = it->second(settings, *this);
   if (!a) throw Error(where + ": analysis factory '" + type + "' returned nothing");
   return a;
 }
@@ -177,6 +244,14 @@ const Attachment& Vehicle::getAttachment(const std::string& name) const {
     throw Error(type_ + " vehicle has no attachment '" + name + "'; known: " + (list.empty() ? "(none)" : list));
   }
   return it->second;
+}
+
+void Vehicle::throwNotA(const std::type_info& type) const {
+  int status = 0;
+  char* d = abi::__cxa_demangle(type.name(), nullptr, nullptr, &status);
+  const std::string name = status == 0 && d ? d : type.name();
+  std::free(d);
+  throw Error("vehicle '" + type_ + "' is not a " + name);
 }
 
 SimTK::State Vehicle::makeInitialState(double speed_m_s) const {

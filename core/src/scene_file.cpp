@@ -246,7 +246,7 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
         const std::string type = e.string("type");
         const std::string name = e.string("name");
         const PluginKind kind = pluginKind(e, type, *registry_);
-        if (!registry_->has(kind, type)) registry_->create(kind, type, PluginSpec{name, e}, e.at("type"));
+        if (!registry_->has(kind, type)) registry_->create(kind, type, PluginSpec{name, e, {}, registry_}, e.at("type"));
         if (!haveVehicle) {
           e.markAllRead();  // the vehicle's error is reported; its plugins cannot be built
           return;
@@ -257,7 +257,7 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
           const ParamReader bind = e.child("bindings");
           for (auto it = bind.json().begin(); it != bind.json().end(); ++it) bindings[it.key()] = bind.string(it.key());
         }
-        b.scene().addPlugin(registry_->create(kind, type, PluginSpec{name, e, bindings}, e.at("type")));
+        b.scene().addPlugin(registry_->create(kind, type, PluginSpec{name, e, bindings, registry_}, e.at("type")));
       });
     }
   }

@@ -4,14 +4,18 @@
 // (4.23)-(4.44) and a reference (tight central differences with two
 // perturbation sizes that agree); each method's error against the reference
 // and its wall time. --vehicle fourws runs the same on the 4WS vehicle.
+// The model is a scene (scenes/ch4_sensitivity.json, ..._fourws.json: the
+// vehicle, its manoeuvre and the design parameters), composed by the scene
+// loader as `vdyn run` does; each design is that scene with overrides.
 #include "vdyn/core/text.h"
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 
 #include "study.h"
+#include "vdyn/analyses/analyses.h"
 #include "vdyn/sensitivity/sensitivity.h"
-#include "vdyn/vehicles/vehicle_designs.h"
+#include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
 
@@ -26,9 +30,6 @@ std::vector<std::string> stringList(const ParamReader& r, const std::string& key
   return v;
 }
 
-CostFunctional costOf(const ParamReader& r) {
-  return CostFunctional::parse(r.string("kind") + ":" + r.string("output"));
-}
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -53,50 +54,41 @@ int main(int argc, char** argv) {
                                  "method and a reference", argc, argv, opts);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
     const std::string vehicle = vm["vehicle"].as<std::string>();
+    if (vehicle != "quarter_car" && vehicle != "fourws")
+      throw Error("--vehicle must be quarter_car or fourws, got '" + vehicle + "'");
+
+    // The model is the scene (one composition: `vdyn run` builds the same
+    // file); its sensitivity analysis names the design parameters, and the
+    // study's options become scene overrides.
+    const ParamReader study = vehicle == "quarter_car" ? data : data.child("fourws");
+    std::vector<Override> overrides;
+    bool relaxation = false;
+    const ParamReader relax = data.child("tire_relaxation");
+    relaxation = relax.boolean("enabled");
+    if (vm.count("tire-relaxation")) {
+      const std::string v = vm["tire-relaxation"].as<std::string>();
+      if (v != "on" && v != "off") throw Error("--tire-relaxation must be on or off, got '" + v + "'");
+      relaxation = v == "on";
+    }
+    const double relaxLongitudinal = requirePositive(relax.number("longitudinal_m"), relax.at("longitudinal_m"));
+    const double relaxLateral = requirePositive(relax.number("lateral_m"), relax.at("lateral_m"));
+    /// The quarter car's tire: relaxation lengths, or 0 (the seed's steady-slip tire).
+    auto tireOverrides = [&](bool on) {
+      return std::vector<Override>{
+          {"vehicle.overrides.tire.params.relaxation_length_longitudinal_m", on ? relaxLongitudinal : 0.0},
+          {"vehicle.overrides.tire.params.relaxation_length_lateral_m", on ? relaxLateral : 0.0}};
+    };
+    if (vehicle == "quarter_car") overrides = tireOverrides(relaxation);
+    const SceneDescription scene =
+        SceneDescription::fromFile(study.string("scene"), standardRegistry(), overrides);
+    const ParamReader analysis = ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis");
 
     SensitivityProblem prob;
-    std::string seedNote;
-    bool relaxation = false;
-    QuarterCarParams quarterCar;
-    if (vehicle == "quarter_car") {
-      QuarterCarParams qp = QuarterCarParams::fromFile(data.string("vehicle_data"));
-      const ParamReader relax = data.child("tire_relaxation");
-      relaxation = relax.boolean("enabled");
-      if (vm.count("tire-relaxation")) {
-        const std::string v = vm["tire-relaxation"].as<std::string>();
-        if (v != "on" && v != "off") throw Error("--tire-relaxation must be on or off, got '" + v + "'");
-        relaxation = v == "on";
-      }
-      if (relaxation) {
-        qp.tire.relaxation_length_longitudinal_m =
-            requirePositive(relax.number("longitudinal_m"), relax.at("longitudinal_m"));
-        qp.tire.relaxation_length_lateral_m = requirePositive(relax.number("lateral_m"), relax.at("lateral_m"));
-      } else {
-        qp.tire.relaxation_length_longitudinal_m = 0;
-        qp.tire.relaxation_length_lateral_m = 0;
-      }
-      prob.model = std::make_shared<QuarterCarDesign>(qp);
-      quarterCar = qp;
-      prob.parameters = stringList(data, "design_parameters");
-      prob.cost = costOf(data.child("cost"));
-      prob.t_end_s = data.number("t_end_s");
-    } else if (vehicle == "fourws") {
-      const ParamReader f = data.child("fourws");
-      const ParamReader man = ParamReader::fromFile(f.string("manoeuvre"));
-      FourWsManoeuvre m;
-      m.speed_m_s = man.number("speed_m_s");
-      m.front_angle_rad = man.number("front_angle_rad");
-      m.rear_angle_rad = man.number("rear_angle_rad");
-      m.steer_start_time_s = man.number("steer_start_time_s");
-      m.steer_duration_s = man.number("steer_duration_s");
-      prob.model = std::make_shared<FourWsDesign>(FourWsParams::fromFile(f.string("vehicle_data")), m);
-      prob.parameters = stringList(f, "design_parameters");
-      prob.cost = costOf(f.child("cost"));
-      prob.t_end_s = f.number("t_end_s");
-    } else {
-      throw Error("--vehicle must be quarter_car or fourws, got '" + vehicle + "'");
-    }
-    prob.integrator = IntegratorSettings::fromParams(data.child("integrator"));
+    prob.model = SceneDesign::fromAnalysis(scene);
+    prob.parameters = stringList(study, "design_parameters");
+    prob.cost = CostFunctional::parse(analysis.string("cost"));
+    prob.t_end_s = analysis.number("t_end_s");
+    prob.integrator = IntegratorSettings::fromParams(analysis.child("integrator"));
     study::applyIntegratorOptions(vm, prob.integrator);
     if (vm.count("params")) prob.parameters = splitList(vm["params"].as<std::string>());
     if (vm.count("t-end-s")) prob.t_end_s = requirePositive(vm["t-end-s"].as<double>(), "--t-end-s");
@@ -116,7 +108,7 @@ int main(int argc, char** argv) {
     std::vector<std::string> methods = splitList(vm["method"].as<std::string>());
     if (methods.size() == 1 && methods[0] == "all") methods = sensitivityMethodNames();
     std::vector<std::unique_ptr<SensitivityMethod>> runners;
-    for (const auto& m : methods) runners.push_back(makeSensitivityMethod(m, set));  // unknown names fail early
+    for (const auto& m : methods) runners.push_back(makeSensitivityMethod(m, set, &standardRegistry()));  // unknown names fail early
     const std::string out = study::outputDir(vm, "ch4_sensitivity");
 
     std::vector<SensitivityResult> results;
@@ -186,12 +178,9 @@ int main(int argc, char** argv) {
     csv.close();
     if (vehicle == "quarter_car" && relaxation) {
       // The seed's steady-slip tire for comparison (fd_central at the same accuracy).
-      QuarterCarParams qs = quarterCar;
-      qs.tire.relaxation_length_longitudinal_m = 0;
-      qs.tire.relaxation_length_lateral_m = 0;
       SensitivityProblem ps = prob;
-      ps.model = std::make_shared<QuarterCarDesign>(qs);
-      const SensitivityResult r = makeSensitivityMethod("fd_central", set)->compute(ps);
+      ps.model = SceneDesign::fromAnalysis(scene.withOverrides(tireOverrides(false)));
+      const SensitivityResult r = makeSensitivityMethod("fd_central", set, &standardRegistry())->compute(ps);
       summary["steady_slip_tire"] = {{"psi", r.psi}, {"dpsi_db", r.dpsi_db}, {"method", "fd_central"},
                                      {"accuracy", ps.integrator.accuracy}, {"wall_time_s", r.wall_time_s}};
       std::printf("  steady-slip tire (fd_central): psi = %.9g, d psi / d b =", r.psi);
@@ -224,7 +213,8 @@ int main(int argc, char** argv) {
       study::plot({p});
     }
 
-    std::printf("ch4_sensitivity: %s%s, %s, T = %g s, %s at accuracy %g\n", prob.model->describe().c_str(),
+    std::printf("ch4_sensitivity: %s%s, %s, T = %g s, %s at accuracy %g\n",
+                vehicle == "quarter_car" ? "quarter car" : "4ws vehicle",
                 vehicle != "quarter_car" ? "" : relaxation ? " (relaxation-length tire)" : " (steady-slip tire)",
                 prob.cost.describe().c_str(), prob.t_end_s, prob.integrator.method.c_str(), prob.integrator.accuracy);
     std::printf("  psi = %.9g\n", psi);

@@ -5,6 +5,7 @@
 // (the App. A 4WS vehicle at a constant speed (3.18), front and rear wheels
 // steered by a smooth step (7.4)), composed through the scene loader like
 // `vdyn run` does, with the programs' options applied as scene overrides.
+// This is the one composition of the manoeuvre (no second builder in C++).
 // Header-only: include it from a target that links vdyn_standard.
 #include <memory>
 #include <string>
@@ -12,7 +13,6 @@
 #include "study.h"
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/core/scene_file.h"
-#include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/fourws.h"
 #include "vdyn/vehicles/standard_registry.h"
 
@@ -23,10 +23,10 @@ struct Ch3Case {
   double speed_m_s = 10;             ///< U0, m/s
   double front_rad = 0, rear_rad = 0;  ///< final steering angles, rad (+ left)
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
-  TransientSettings transient;       ///< the scene's "analysis" (a transient)
-  SimulationSettings sim;            ///< transient.simulation()
+  TransientSettings transient{};     ///< the scene's "analysis" (a transient)
+  SimulationSettings sim{};          ///< transient.simulation()
   /// "constrained" or "reduced" overrides the vehicle file's corner_model; empty keeps it.
-  std::string corner_model;
+  std::string corner_model{};
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
   /// --integrator, --accuracy.
@@ -92,29 +92,11 @@ struct Ch3Case {
 
   /// The scene: the vehicle with its steering ("front_steer", "rear_steer")
   /// and speed hold ("speed_hold"), built by the scene loader. `cornerModel`
-  /// (if not empty) overrides corner_model.
+  /// (if not empty) overrides corner_model. Code that needs the vehicle's own
+  /// C++ API takes it from the built scene: build().vehicleAs<FourWsVehicle>().
   BuiltScene build(const std::string& cornerModel = "") const {
     if (cornerModel.empty()) return scene.build();
     return scene.withOverride("vehicle.overrides.corner_model", checkedCornerModel(cornerModel)).build();
-  }
-
-  /// The same vehicle as a concrete FourWsVehicle, for code that needs its
-  /// C++ API (ch3_work_precision maps the reduced model's state from the
-  /// constrained one): the scene's vehicle data and the values read from it.
-  std::unique_ptr<FourWsVehicle> buildVehicle(const std::string& cornerModel = "") const {
-    const Json& v = scene.json().at("vehicle");
-    Json data = ParamReader::fromFile(scene.resolve(v.at("data").get<std::string>())).json();
-    if (v.contains("overrides")) data.merge_patch(v.at("overrides"));
-    FourWsParams p = FourWsParams::fromParams(ParamReader::fromJson(data, scene.path() + " vehicle"));
-    if (!corner_model.empty()) p.corner_model = corner_model;
-    if (!cornerModel.empty()) p.corner_model = checkedCornerModel(cornerModel);
-    auto car = std::make_unique<FourWsVehicle>(p);
-    car->addAxleSteering("front_steer", true,
-                         std::make_shared<SmoothStepCommand>(0, front_rad, steer_start_s, steer_duration_s));
-    car->addAxleSteering("rear_steer", false,
-                         std::make_shared<SmoothStepCommand>(0, rear_rad, steer_start_s, steer_duration_s));
-    car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", speed_m_s));
-    return car;
   }
 
   static std::string checkedCornerModel(const std::string& m) {

@@ -22,7 +22,7 @@ int main(int argc, char** argv) {
     study::addIntegratorOptions(opts);
     const auto vm = study::parse("quarter_car", "chapter 4 quarter car on a sine road, cost psi = int z''^2 dt",
                                  argc, argv, opts);
-    // The scene (scenes/quarter_car.json) composed and run as `vdyn run` does;
+    // The scene (scenes/quarter_car_sine_road.json) composed and run as `vdyn run` does;
     // the options become scene overrides.
     std::vector<Override> o = {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}};
     if (vm.count("integrator")) o.push_back({"analysis.integrator.method", vm["integrator"].as<std::string>()});
@@ -30,7 +30,7 @@ int main(int argc, char** argv) {
     if (vm.count("t-end-s"))
       o.push_back({"analysis.t_end_s", requirePositive(vm["t-end-s"].as<double>(), "--t-end-s")});
     if (vm.count("report-interval-s")) o.push_back({"analysis.report_interval_s", vm["report-interval-s"].as<double>()});
-    const SceneDescription scene = SceneDescription::fromFile("scenes/quarter_car.json", standardRegistry(), o);
+    const SceneDescription scene = SceneDescription::fromFile("scenes/quarter_car_sine_road.json", standardRegistry(), o);
     const TransientSettings settings = TransientSettings::fields().read(
         ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
     const SimulationSettings sim = settings.simulation();

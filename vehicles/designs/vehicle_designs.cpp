@@ -1,6 +1,5 @@
 #include "vdyn/vehicles/vehicle_designs.h"
 
-#include "vdyn/speed/speed_hold.h"
 
 namespace vdyn {
 
@@ -94,59 +93,10 @@ class QuarterCarInstance : public DesignInstance {
   QuarterCar car_;
 };
 
-class FourWsInstance : public DesignInstance {
- public:
-  FourWsInstance(const FourWsParams& p, const FourWsManoeuvre& m) : car_(p), speed_(m.speed_m_s) {
-    car_.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, m.front_angle_rad,
-                                                                                 m.steer_start_time_s,
-                                                                                 m.steer_duration_s));
-    car_.addAxleSteering("rear_steer", false, std::make_shared<SmoothStepCommand>(0, m.rear_angle_rad,
-                                                                                m.steer_start_time_s,
-                                                                                m.steer_duration_s));
-    car_.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", m.speed_m_s));
-  }
-  Scene& updScene() override { return car_.updScene(); }
-  const Scene& getScene() const override { return car_.getScene(); }
-  SimTK::State makeInitialState() const override { return car_.makeInitialState(speed_); }
-
- private:
-  FourWsVehicle car_;
-  double speed_;
-};
 }  // namespace
 
 std::unique_ptr<DesignInstance> QuarterCarDesign::DoBuild(const std::vector<double>& b) const {
   return std::make_unique<QuarterCarInstance>(paramsFor(b));
-}
-
-static std::vector<FieldHandle<FourWsParams>> fourWsHandles() {
-  using P = FourWsParams;
-  return {
-      {{"chassis.mass_kg", "m1", "kg", 0, 100}, [](P& p) -> double& { return p.chassis.mass_kg; }},
-      {{"front.spring.stiffness_N_per_m", "Kf", "N/m", 0, 1e4},
-       [](P& p) -> double& { return p.front_right.spring_stiffness_N_per_m; }},
-      {{"front.spring.damping_N_s_per_m", "Df", "N s/m", 0, 1e3},
-       [](P& p) -> double& { return p.front_right.damper_N_s_per_m; }},
-      {{"rear.spring.stiffness_N_per_m", "Kr", "N/m", 0, 1e4},
-       [](P& p) -> double& { return p.rear_right.spring_stiffness_N_per_m; }},
-      {{"rear.spring.damping_N_s_per_m", "Dr", "N s/m", 0, 1e3},
-       [](P& p) -> double& { return p.rear_right.damper_N_s_per_m; }},
-      {{"tire.radial_stiffness_N_per_m", "Cz", "N/m", 0, 1e5},
-       [](P& p) -> double& { return p.tire.radial_stiffness_N_per_m; }},
-  };
-}
-
-FourWsDesign::FourWsDesign(const FourWsParams& nominal, const FourWsManoeuvre& m)
-    : DesignModel(paramsOf(fourWsHandles(), nominal)), nominal_(nominal), manoeuvre_(m), handles_(fourWsHandles()) {
-  nominal_.validate();
-  requirePositive(m.speed_m_s, "4ws manoeuvre speed_m_s");
-}
-
-std::unique_ptr<DesignInstance> FourWsDesign::DoBuild(const std::vector<double>& b) const {
-  FourWsParams p = nominal_;
-  for (std::size_t i = 0; i < handles_.size(); ++i) handles_[i].field(p) = b[i];
-  p.validate();
-  return std::make_unique<FourWsInstance>(p, manoeuvre_);
 }
 
 }  // namespace vdyn

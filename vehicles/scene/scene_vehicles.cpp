@@ -44,9 +44,9 @@ class FourWsSceneVehicle : public Vehicle {
                          {"spin_axis", axisText(car_.cornerParams(c).wheel_spin_axis)}};
     }
   }
-  FourWsVehicle& car() { return car_; }
 
  protected:
+  void* DoGetConcrete(const std::type_info& t) override { return t == typeid(FourWsVehicle) ? &car_ : nullptr; }
   Scene& DoUpdScene() override { return car_.updScene(); }
   SimTK::State DoMakeInitialState(double speed) const override {
     return car_.makeInitialState(speed, &assembly_);
@@ -74,6 +74,7 @@ class BicycleSceneVehicle : public Vehicle {
   }
 
  protected:
+  void* DoGetConcrete(const std::type_info& t) override { return t == typeid(Bicycle) ? &bike_ : nullptr; }
   Scene& DoUpdScene() override { return bike_.updScene(); }
   SimTK::State DoMakeInitialState(double speed) const override { return bike_.makeInitialState(speed); }
   Json DoDescribe(const SimTK::State& s) const override {
@@ -90,12 +91,15 @@ class BicycleSceneVehicle : public Vehicle {
 class QuarterCarSceneVehicle : public Vehicle {
  public:
   QuarterCarSceneVehicle(const VehicleSpec& spec)
-      : Vehicle("quarter_car"), car_(QuarterCarParams::fromParams(spec.data), *spec.registry) {
+      : Vehicle("quarter_car"),
+        car_(QuarterCarParams::fromParams(spec.data), *spec.registry),
+        rideHeightSpring_(spec.data.json().value("spring_free_length_from_ride_height", false)) {
     attachments_["chassis"] = {{"chassis", "chassis"}};
     attachments_["corner"] = {{"chassis", "chassis"}, {"wheel", "wheel"}, {"knuckle", "knuckle"}};
   }
 
  protected:
+  void* DoGetConcrete(const std::type_info& t) override { return t == typeid(QuarterCar) ? &car_ : nullptr; }
   Scene& DoUpdScene() override { return car_.updScene(); }
   SimTK::State DoMakeInitialState(double speed) const override {
     if (speed != 0)
@@ -109,9 +113,16 @@ class QuarterCarSceneVehicle : public Vehicle {
             {"assembly_max_body_move_m", assembly_.max_move_m},
             {"assembly_initial_loop_gap_m", assembly_.initial_loop_gap_m}};
   }
+  /// The spring free length the ride-height rule set, as data.
+  Json DoGetDerivedData() const override {
+    if (!rideHeightSpring_) return Json::object();
+    return {{"spring_free_length_from_ride_height", false},
+            {"corner_overrides", {{"spring", {{"free_length_m", car_.params().corner.spring_free_length_m}}}}}};
+  }
 
  private:
   QuarterCar car_;
+  bool rideHeightSpring_;
   mutable AssemblyReport assembly_;
 };
 

@@ -41,9 +41,30 @@ class SceneInstance : public DesignInstance {
 };
 }  // namespace
 
+/// The merge patch `j` as overrides of vehicle.overrides.<path> (objects
+/// descend; any other value is set at its path).
+void flattenPatch(const Json& j, const std::string& prefix, std::vector<Override>& out) {
+  if (!j.is_object()) {
+    out.push_back({prefix, j});
+    return;
+  }
+  for (auto it = j.begin(); it != j.end(); ++it) flattenPatch(it.value(), prefix + "." + it.key(), out);
+}
+
 SceneDesign::SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params)
     : DesignModel(params), scene_(scene) {
   for (const auto& p : params) paths_.push_back(p.name);
+}
+
+SceneDesign::SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params,
+                         std::vector<std::string> keyPaths, const Json& heldData)
+    : DesignModel(params), scene_(scene), paths_(std::move(keyPaths)) {
+  if (paths_.size() != params.size())
+    throw Error("scene design: " + std::to_string(params.size()) + " parameters but " +
+                std::to_string(paths_.size()) + " key paths");
+  if (heldData.is_object())
+    for (auto it = heldData.begin(); it != heldData.end(); ++it)
+      flattenPatch(it.value(), "vehicle.overrides." + it.key(), held_);
 }
 
 std::vector<DesignParameter> SceneDesign::parametersOf(const SceneDescription& scene,
@@ -82,7 +103,7 @@ std::vector<DesignParameter> SceneDesign::parametersOf(const SceneDescription& s
 }
 
 std::unique_ptr<DesignInstance> SceneDesign::DoBuild(const std::vector<double>& values) const {
-  std::vector<Override> overrides;
+  std::vector<Override> overrides = held_;  // held first: a parameter that is a held value wins
   for (std::size_t i = 0; i < values.size(); ++i) {
     const std::string& path = paths_[i];
     const std::string target =
@@ -93,9 +114,16 @@ std::unique_ptr<DesignInstance> SceneDesign::DoBuild(const std::vector<double>& 
 }
 
 namespace {
+/// One entry of "parameters": a scene key path, or an object naming it.
+struct ParameterSpec {
+  std::string path, name, symbol, unit;
+  double scale = 0;  ///< 0 = from "scales", else |nominal| (1 if 0)
+};
+
 struct SensitivityEntry {
-  std::vector<std::string> parameters;
+  std::vector<ParameterSpec> parameters;
   std::vector<double> scales;
+  std::string derived_data = "nominal";
   std::string cost;
   std::vector<std::string> methods = {"fd_central"};
   double t_end_s = 1.0;
@@ -109,12 +137,38 @@ const FieldTable<SensitivityEntry>& sensitivityFields() {
   using E = SensitivityEntry;
   static const auto t =
       FieldTable<E>()
-          .strings("parameters", &E::parameters,
-                   "design parameters b: scene key paths; vehicle.data.<path> = a value of the vehicle data file")
+          .custom("parameters", "-", "required",
+                  "design parameters b: scene key paths (vehicle.data.<path> = a value of the vehicle data file), "
+                  "or objects {path, name, symbol, unit, scale} naming them",
+                  [](const ParamReader& r, E& e) {
+                    e.parameters.clear();
+                    if (!r.has("parameters")) return;
+                    const Json& v = r.json().at("parameters");
+                    if (!v.is_array()) throw Error(r.at("parameters") + ": expected an array, got " + v.dump());
+                    for (std::size_t i = 0; i < v.size(); ++i) {
+                      ParameterSpec p;
+                      if (v[i].is_string()) {
+                        p.path = p.name = p.symbol = v[i].get<std::string>();
+                      } else {
+                        const ParamReader o = r.array("parameters")[i];
+                        p.path = o.string("path");
+                        p.name = o.stringOr("name", p.path);
+                        p.symbol = o.stringOr("symbol", p.name);
+                        p.unit = o.stringOr("unit", "");
+                        if (o.has("scale")) p.scale = requirePositive(o.number("scale"), o.at("scale"));
+                      }
+                      e.parameters.push_back(p);
+                    }
+                  })
+          .string("derived_data", &E::derived_data,
+                  "nominal (values the vehicle derives from a rule, e.g. the quarter car's spring free length "
+                  "from the ride height, are held at the nominal design's: a datum) | each_design (re-derived)")
           .numbers("scales", &E::scales, "(parameter's)",
                    "typical size of each parameter: perturbations scale with max(|b|, scale) (default |b|, or 1 if 0)")
           .string("cost", &E::cost, "integral_of_square|maximum|final_value:<output> (4.46)", true)
-          .strings("methods", &E::methods, "fd_forward | fd_central | mixed | reference, each run in turn")
+          .strings("methods", &E::methods,
+                   "sensitivity_method names (fd_forward | fd_central | mixed | reference | ...: `vdyn list "
+                   "sensitivity_method`), each run in turn")
           .number("t_end_s", &E::t_end_s, "s", "cost horizon")
           .custom("integrator", "-", "{\"method\": \"rk_merson\", \"accuracy\": 1e-6}", "integrator of the runs",
                   [](const ParamReader& r, E& e) {
@@ -125,17 +179,47 @@ const FieldTable<SensitivityEntry>& sensitivityFields() {
   return t;
 }
 
+/// The design model of `e` on `scene`; `nominal` (the scene built at the
+/// nominal design, or nullptr to build it) gives the derived data to hold.
+std::shared_ptr<SceneDesign> designOf(const SceneDescription& scene, const SensitivityEntry& e, const Vehicle* nominal) {
+  std::vector<std::string> paths;
+  for (const auto& p : e.parameters) paths.push_back(p.path);
+  auto params = SceneDesign::parametersOf(scene, paths);
+  for (std::size_t i = 0; i < params.size(); ++i) {
+    const ParameterSpec& s = e.parameters[i];
+    params[i].name = s.name;
+    params[i].symbol = s.symbol;
+    params[i].unit = s.unit;
+    if (i < e.scales.size()) params[i].scale = e.scales[i];
+    if (s.scale > 0) params[i].scale = s.scale;
+  }
+  Json held = Json::object();
+  if (e.derived_data == "nominal") {
+    if (nominal) {
+      held = nominal->derivedData();
+    } else {
+      const BuiltScene b = scene.build();
+      held = b.vehicle->derivedData();
+    }
+  }
+  return std::make_shared<SceneDesign>(scene, params, paths, held);
+}
+
 class SensitivityAnalysis : public Analysis {
  public:
-  explicit SensitivityAnalysis(const ParamReader& r) : Analysis("sensitivity") {
+  SensitivityAnalysis(const ParamReader& r, const PluginRegistry& registry)
+      : Analysis("sensitivity"), registry_(&registry) {
     sensitivityFields().read(r, e_);
     if (e_.parameters.empty()) throw Error(r.at("parameters") + ": name at least one design parameter");
     if (!e_.scales.empty() && e_.scales.size() != e_.parameters.size())
       throw Error(r.at("scales") + ": one scale per parameter (" + std::to_string(e_.parameters.size()) + "), got " +
                   std::to_string(e_.scales.size()));
     for (double x : e_.scales) requirePositive(x, r.at("scales"));
+    if (e_.derived_data != "nominal" && e_.derived_data != "each_design")
+      throw Error(r.at("derived_data") + ": expected nominal or each_design, got '" + e_.derived_data + "'");
     cost_ = CostFunctional::parse(e_.cost);
-    for (const auto& m : e_.methods) makeSensitivityMethod(m);  // named error now, not after a run
+    for (const auto& m : e_.methods)  // named error now, not after a run
+      if (!registry.hasChoice("sensitivity_method", m)) makeSensitivityMethod(m, {}, &registry);
     requirePositive(e_.t_end_s, r.at("t_end_s"));
     e_.settings.tolerance = e_.tolerance;
     e_.settings.perturbation = e_.perturbation;
@@ -144,22 +228,20 @@ class SensitivityAnalysis : public Analysis {
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
     SensitivityProblem problem;
-    auto params = SceneDesign::parametersOf(ctx.description, e_.parameters);
-    for (std::size_t i = 0; i < e_.scales.size(); ++i) params[i].scale = e_.scales[i];
-    problem.model = std::make_shared<SceneDesign>(ctx.description, params);
-    problem.parameters = e_.parameters;
+    problem.model = designOf(ctx.description, e_, ctx.built.vehicle.get());
+    for (const auto& p : e_.parameters) problem.parameters.push_back(p.name);
     problem.cost = cost_;
     problem.t_end_s = e_.t_end_s;
     problem.integrator = e_.integrator;
     problem.validate();
     AnalysisResult res;
-    res.summary["parameters"] = e_.parameters;
+    res.summary["parameters"] = problem.parameters;
     res.summary["cost"] = cost_.describe();
     Table t;
     t.columns = {"method_index", "parameter_index", "dpsi_db", "error_estimate"};
     Json methods = Json::object();
     for (std::size_t m = 0; m < e_.methods.size(); ++m) {
-      const SensitivityResult r = makeSensitivityMethod(e_.methods[m], e_.settings)->compute(problem);
+      const SensitivityResult r = makeSensitivityMethod(e_.methods[m], e_.settings, registry_)->compute(problem);
       res.summary["psi"] = r.psi;
       methods[r.method] = {{"psi", r.psi},
                            {"dpsi_db", r.dpsi_db},
@@ -176,14 +258,30 @@ class SensitivityAnalysis : public Analysis {
   }
 
  private:
+  const PluginRegistry* registry_;  // the scene's: methods an out-of-tree library registered are found
   SensitivityEntry e_;
   CostFunctional cost_;
 };
 }  // namespace
 
+std::shared_ptr<SceneDesign> SceneDesign::fromAnalysis(const SceneDescription& scene) {
+  const std::string where = scene.path() + " analysis";
+  if (!scene.json().contains("analysis")) throw Error(scene.path() + ": no analysis (a sensitivity analysis names the design parameters)");
+  const ParamReader r = ParamReader::fromJson(scene.json().at("analysis"), where);
+  if (r.string("type") != "sensitivity")
+    throw Error(r.at("type") + ": expected a sensitivity analysis (its parameters make the design), got '" +
+                r.string("type") + "'");
+  SensitivityEntry e;
+  sensitivityFields().read(r, e);
+  if (e.parameters.empty()) throw Error(r.at("parameters") + ": name at least one design parameter");
+  return designOf(scene, e, nullptr);
+}
+
 void registerSensitivityAnalysis(PluginRegistry& registry) {
+  registerSensitivityMethods(registry);
   registry.addAnalysis(
-      "sensitivity", [](const ParamReader& r) { return std::make_unique<SensitivityAnalysis>(r); },
+      "sensitivity",
+      [](const ParamReader& r, const PluginRegistry& reg) { return std::make_unique<SensitivityAnalysis>(r, reg); },
       {"design sensitivity d psi / d b (ch. 4) of a cost over the transient, by finite differences, the mixed "
        "method or the reference; parameters are scene key paths (SceneDesign)",
        sensitivityFields().describe()});

@@ -44,16 +44,45 @@ const std::vector<std::string>& rearSteerStrategyNames() {
   return names;
 }
 
+void registerRearSteerStrategies(PluginRegistry& registry) {
+  using C = RearSteerContext;
+  registry.addChoice<RearSteerStrategy, C>(
+      "rear_steer_strategy", "2ws", [](const ParamReader&, const C&) { return std::make_unique<TwoWsStrategy>(); },
+      {"delta_r* = 0: conventional front steering", {}});
+  registry.addChoice<RearSteerStrategy, C>(
+      "rear_steer_strategy", "linear",
+      [](const ParamReader&, const C& c) { return std::make_unique<LinearKrStrategy>(c.linear); },
+      {"delta_r* = Kr(U) delta_f, Kr of the linear bicycle at the current speed (6.1)-(6.9), (8.2)-(8.4)",
+       {{"linear_bicycle", "-", "defaults", "the rear_steer plugin's linear bicycle"}}});
+  registry.addChoice<RearSteerStrategy, C>(
+      "rear_steer_strategy", "nonlinear",
+      [](const ParamReader&, const C& c) -> std::unique_ptr<RearSteerStrategy> {
+        if (!c.table) throw Error("rear steer strategy 'nonlinear' needs a Kr coefficient table");
+        return std::make_unique<NonlinearKrStrategy>(*c.table);
+      },
+      {"Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1 and C2 interpolated in speed (Table 8.1)",
+       {{"kr_table", "-", "required", "the rear_steer plugin's coefficient table file (kr_table.json)"}}});
+}
+
+namespace {
+const PluginRegistry& builtinStrategies() {
+  static const PluginRegistry r = [] {
+    PluginRegistry reg;
+    registerRearSteerStrategies(reg);
+    return reg;
+  }();
+  return r;
+}
+}  // namespace
+
 std::shared_ptr<const RearSteerStrategy> makeRearSteerStrategy(const std::string& name,
                                                                const LinearBicycleParams& linear,
-                                                               const KrTable* table) {
-  if (name == "2ws") return std::make_shared<TwoWsStrategy>();
-  if (name == "linear") return std::make_shared<LinearKrStrategy>(linear);
-  if (name == "nonlinear") {
-    if (!table) throw Error("rear steer strategy 'nonlinear' needs a Kr coefficient table");
-    return std::make_shared<NonlinearKrStrategy>(*table);
-  }
-  throw Error("unknown rear steer strategy '" + name + "'; known: 2ws, linear, nonlinear");
+                                                               const KrTable* table, const PluginRegistry* registry,
+                                                               const ParamReader* params) {
+  const PluginRegistry& reg = registry ? *registry : builtinStrategies();
+  const ParamReader none = ParamReader::fromJson(Json::object(), "rear steer strategy '" + name + "'");
+  return reg.createChoice<RearSteerStrategy, RearSteerContext>("rear_steer_strategy", name, params ? *params : none,
+                                                               RearSteerContext{linear, table}, "");
 }
 
 void RearSteerParams::validate() const {
@@ -146,11 +175,14 @@ void RearSteerPlugin::DoAddTo(Scene& scene) {
 }
 
 void registerRearSteerPlugins(PluginRegistry& registry) {
+  registerRearSteerStrategies(registry);
   std::vector<FieldInfo> fields = {
       {"rear_steering", "-", "required", "state-driven rear steering plugin it drives (bindable)"},
       {"front_steering", "-", "required", "front steering plugin it follows (bindable)"},
       {"chassis", "-", "required", "chassis body (bindable)"},
-      {"strategy", "-", "required", "2ws | linear (Kr(U), 6.1-6.9) | nonlinear (Kr = C1 + C2 delta_f^2, 8.1)"},
+      {"strategy", "-", "required",
+       "a rear_steer_strategy: 2ws | linear (Kr(U), 6.1-6.9) | nonlinear (Kr = C1 + C2 delta_f^2, 8.1) | ... "
+       "(`vdyn list rear_steer_strategy`)"},
       {"linear_bicycle", "-", "defaults", "linear bicycle {mass_kg, front/rear_axle_to_com_m, cornering stiffnesses}"},
       {"kr_table", "-", "none", "coefficient table file of the nonlinear strategy (kr_table.json)"}};
   for (auto f : trackingFields().describe()) fields.push_back(std::move(f));
@@ -165,7 +197,8 @@ void registerRearSteerPlugins(PluginRegistry& registry) {
           table = std::make_unique<KrTable>(KrTable::fromFile(resolveDataPath(r.string("kr_table"))));
         return std::make_unique<RearSteerPlugin>(spec.name, spec.bound("rear_steering"), spec.bound("front_steering"),
                                                  spec.bound("chassis"),
-                                                 makeRearSteerStrategy(r.string("strategy"), linear, table.get()),
+                                                 makeRearSteerStrategy(r.string("strategy"), linear, table.get(),
+                                                                       spec.registry, &r),
                                                  RearSteerParams::fromParams(r));
       },
       {"rear-wheel steering law tracking a target delta_r* (8.1)-(8.8)", fields});

@@ -187,14 +187,44 @@ const std::vector<std::string>& sensitivityMethodNames() {
   return names;
 }
 
-std::unique_ptr<SensitivityMethod> makeSensitivityMethod(const std::string& name, const SensitivitySettings& s) {
-  if (name == "fd_forward") return std::make_unique<FiniteDifferenceMethod>(false, s);
-  if (name == "fd_central") return std::make_unique<FiniteDifferenceMethod>(true, s);
-  if (name == "reference") return std::make_unique<ReferenceMethod>(s);
-  if (name == "mixed") return detail::makeMixedMethod(s);
-  std::string list;
-  for (const auto& n : sensitivityMethodNames()) list += (list.empty() ? "" : ", ") + n;
-  throw Error("unknown sensitivity method '" + name + "'; known: " + list);
+void registerSensitivityMethods(PluginRegistry& registry) {
+  using S = SensitivitySettings;
+  registry.addChoice<SensitivityMethod, S>(
+      "sensitivity_method", "fd_forward",
+      [](const ParamReader&, const S& s) { return std::make_unique<FiniteDifferenceMethod>(false, s); },
+      {"forward differences (4.21): r + 1 simulations, step sqrt(eps) max(|b|, scale)",
+       {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
+  registry.addChoice<SensitivityMethod, S>(
+      "sensitivity_method", "fd_central",
+      [](const ParamReader&, const S& s) { return std::make_unique<FiniteDifferenceMethod>(true, s); },
+      {"central differences (4.22): 2 r + 1 simulations, step cbrt(eps) max(|b|, scale)",
+       {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
+  registry.addChoice<SensitivityMethod, S>(
+      "sensitivity_method", "mixed", [](const ParamReader&, const S& s) { return detail::makeMixedMethod(s); },
+      {"the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients, one simulation",
+       {{"tolerance", "", "1e-05", "relative tolerance on the Richardson estimate of each d psi / d b_i"}}});
+  registry.addChoice<SensitivityMethod, S>(
+      "sensitivity_method", "reference",
+      [](const ParamReader&, const S& s) { return std::make_unique<ReferenceMethod>(s); },
+      {"central differences at a tight accuracy with two perturbation sizes that must agree (Richardson)", {}});
+}
+
+namespace {
+const PluginRegistry& builtinMethods() {
+  static const PluginRegistry r = [] {
+    PluginRegistry reg;
+    registerSensitivityMethods(reg);
+    return reg;
+  }();
+  return r;
+}
+}  // namespace
+
+std::unique_ptr<SensitivityMethod> makeSensitivityMethod(const std::string& name, const SensitivitySettings& s,
+                                                         const PluginRegistry* registry) {
+  const PluginRegistry& reg = registry ? *registry : builtinMethods();
+  const ParamReader none = ParamReader::fromJson(Json::object(), "sensitivity method '" + name + "'");
+  return reg.createChoice<SensitivityMethod, SensitivitySettings>("sensitivity_method", name, none, s, "");
 }
 
 }  // namespace vdyn

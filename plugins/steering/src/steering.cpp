@@ -61,21 +61,50 @@ SteerCommandValue StepSequenceCommand::DoCalc(double t) const {
   return v;
 }
 
-std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r) {
-  const std::string type = r.string("type");
-  if (type == "hold") return std::make_shared<HoldCommand>(r.numberOr("angle_rad", 0.0));
-  if (type == "smooth_step") {
-    const double d0 = r.numberOr("initial_rad", 0.0);
-    return std::make_shared<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
-                                               r.number("duration_s"));
-  }
-  if (type == "steps") {
-    std::vector<StepSequenceCommand::Step> steps;
-    for (const auto& k : r.array("steps"))
-      steps.push_back({k.number("start_time_s"), k.number("duration_s"), k.number("change_rad")});
-    return std::make_shared<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
-  }
-  throw Error(r.at("type") + ": unknown steering command '" + type + "'; known: hold, smooth_step, steps");
+void registerSteeringCommands(PluginRegistry& registry) {
+  registry.addChoice<SteeringCommand>(
+      "steering_command", "hold",
+      [](const ParamReader& r, const NoContext&) { return std::make_unique<HoldCommand>(r.numberOr("angle_rad", 0.0)); },
+      {"a constant angle (HoldCommand; adjustable angle_rad)", {{"angle_rad", "rad", "0", "held angle, + left"}}});
+  registry.addChoice<SteeringCommand>(
+      "steering_command", "smooth_step",
+      [](const ParamReader& r, const NoContext&) {
+        const double d0 = r.numberOr("initial_rad", 0.0);
+        return std::make_unique<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
+                                                   r.number("duration_s"));
+      },
+      {"the seed's smooth step (7.4)-(7.5) from initial_rad to final_rad",
+       {{"initial_rad", "rad", "0", "angle before the step, + left"},
+        {"final_rad", "rad", "required", "angle after the step, + left"},
+        {"start_time_s", "s", "required", "t_i, start of the step"},
+        {"duration_s", "s", "required", "T, duration of the step"}}});
+  registry.addChoice<SteeringCommand>(
+      "steering_command", "steps",
+      [](const ParamReader& r, const NoContext&) {
+        std::vector<StepSequenceCommand::Step> steps;
+        for (const auto& k : r.array("steps"))
+          steps.push_back({k.number("start_time_s"), k.number("duration_s"), k.number("change_rad")});
+        return std::make_unique<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+      },
+      {"smooth steps (7.4) added together (Figure 7.2's open-loop inputs)",
+       {{"initial_rad", "rad", "0", "angle before the first step, + left"},
+        {"steps", "-", "required", "[{start_time_s (s), duration_s (s), change_rad (rad)}, ...]"}}});
+}
+
+namespace {
+const PluginRegistry& builtinCommands() {
+  static const PluginRegistry r = [] {
+    PluginRegistry reg;
+    registerSteeringCommands(reg);
+    return reg;
+  }();
+  return r;
+}
+}  // namespace
+
+std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r, const PluginRegistry* registry) {
+  const PluginRegistry& reg = registry ? *registry : builtinCommands();
+  return reg.createChoice<SteeringCommand>("steering_command", r.string("type"), r, NoContext{}, r.at("type"));
 }
 
 // ---------------------------------------------------------------------------
@@ -378,6 +407,7 @@ std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene) {
 namespace {
 /// The keys of a "steering" plugin entry (one table: read, documented by `vdyn list`).
 struct SteeringEntry {
+  const PluginRegistry* registry = nullptr;  ///< where the command's type is looked up
   std::string chassis = "chassis";
   std::vector<std::string> knuckles;
   Vec3 spin_axis{0, 1, 0};
@@ -394,16 +424,15 @@ const FieldTable<SteeringEntry>& steeringFields() {
                    "knuckle bodies steered together, e.g. [\"rf.knuckle\", \"lf.knuckle\"] (bindable: attach an axle)")
           .vec3("spin_axis", &SteeringEntry::spin_axis, "-", "wheel spin axis in the knuckle frame (bindable)")
           .custom("command", "-", "required",
-                  "{type: hold (angle_rad) | smooth_step (initial_rad, final_rad, start_time_s, duration_s; 7.4) | "
-                  "steps (initial_rad, steps: [{start_time_s, duration_s, change_rad}]) | state (initial_rad: a "
-                  "controller sets delta'')}; rad, + left",
+                  "{type: a steering_command (hold, smooth_step, steps, ...: `vdyn list steering_command`) with "
+                  "its keys | state (initial_rad: a controller sets delta'')}; rad, + left",
                   [](const ParamReader& r, SteeringEntry& e) {
                     const ParamReader c = r.child("command");
                     if (c.stringOr("type", "") == "state") {
                       e.state_driven = true;
                       e.initial_rad = c.numberOr("initial_rad", 0.0);
                     } else {
-                      e.command = makeSteeringCommand(c);
+                      e.command = makeSteeringCommand(c, e.registry);
                     }
                   });
   return t;
@@ -419,10 +448,12 @@ Vec3 parseAxis(const std::string& text, const std::string& where) {
 }  // namespace
 
 void registerSteeringPlugins(PluginRegistry& registry) {
+  registerSteeringCommands(registry);
   registry.add(
       PluginKind::Constraint, "steering",
       [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
         SteeringEntry e;
+        e.registry = spec.registry;
         steeringFields().read(spec.params, e);
         if (spec.bindings.count("chassis")) e.chassis = spec.bindings.at("chassis");
         if (spec.bindings.count("knuckles")) e.knuckles = splitList(spec.bindings.at("knuckles"));

@@ -20,9 +20,10 @@
 
 /// Bumped whenever a class a plugin derives from or calls (Plugin and its kinds,
 /// PluginRegistry, PluginSpec, ParamReader, Scene, Vehicle, Analysis, TypeInfo)
-/// changes its layout or virtual functions. A library must return the value it
+/// changes its layout or virtual functions. 2: PluginSpec::registry, choices
+/// in PluginRegistry, Vehicle::getConcrete/derivedData. A library must return the value it
 /// was compiled with from vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 1
+#define VDYN_PLUGIN_ABI_VERSION 2
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))

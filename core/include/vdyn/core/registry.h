@@ -10,6 +10,7 @@
 #include <map>
 #include <memory>
 #include <string>
+#include <typeinfo>
 #include <vector>
 
 #include "vdyn/core/analysis.h"
@@ -20,6 +21,8 @@
 
 namespace vdyn {
 
+class PluginRegistry;
+
 /// What a factory receives: its parameters (the data-file object) and the
 /// instance name the scene will know it by.
 struct PluginSpec {
@@ -28,11 +31,38 @@ struct PluginSpec {
   /// Names a vehicle builder binds for the plugin (e.g. "wheel" -> "rf.wheel");
   /// a binding takes precedence over a string key of the same name in params.
   std::map<std::string, std::string> bindings = {};
+  /// The registry the scene is built from: a factory looks up the choices it
+  /// makes by name there (a steering command, a rear-steer strategy), so
+  /// out-of-tree ones are found too. nullptr = the library's built-ins only.
+  const PluginRegistry* registry = nullptr;
   std::string bound(const std::string& key) const {
     auto it = bindings.find(key);
     return it != bindings.end() ? it->second : params.string(key);
   }
 };
+
+/// Empty context of a choice family whose factories need only their parameters.
+struct NoContext {};
+
+/// A choice made by name inside a plugin or an analysis: a steering command
+/// ("steering_command": hold, smooth_step, steps), a rear-steer strategy
+/// ("rear_steer_strategy": 2ws, linear, nonlinear), a sensitivity method
+/// ("sensitivity_method": fd_forward, fd_central, mixed, reference). Each
+/// family has one interface Base and one Context its factories receive besides
+/// their parameters (the data-file object that names the choice); the library
+/// that defines a family registers its built-ins, an out-of-tree library adds
+/// more with addChoice in vdyn_register_plugins, and `vdyn list` prints them.
+template <class Base, class Context = NoContext>
+using ChoiceFactory = std::function<std::unique_ptr<Base>(const ParamReader& params, const Context& context)>;
+
+namespace detail {
+/// T in a non-deduced context (std::type_identity of C++20): addChoice<Base>
+/// takes a lambda and the Context default.
+template <class T>
+struct NonDeduced {
+  using type = T;
+};
+}  // namespace detail
 
 class PluginRegistry {
  public:
@@ -40,6 +70,7 @@ class PluginRegistry {
   using VehicleFactory = std::function<std::unique_ptr<Vehicle>(const VehicleSpec&)>;
   /// Reads (and so validates) the analysis settings; throws Error naming the key.
   using AnalysisFactory = std::function<std::unique_ptr<Analysis>(const ParamReader& settings)>;
+
 
   /// Registers a plugin factory (force element, constraint, controller); throws
   /// if (kind, type) is already registered.
@@ -64,13 +95,59 @@ class PluginRegistry {
   std::unique_ptr<Analysis> createAnalysis(const std::string& type, const ParamReader& settings,
                                            const std::string& where) const;
 
+  /// An analysis whose settings name choices (e.g. sensitivity methods): its
+  /// factory also receives the registry, to create or check them at load time.
+  using AnalysisFactoryWithRegistry =
+      std::function<std::unique_ptr<Analysis>(const ParamReader& settings, const PluginRegistry& registry)>;
+  void addAnalysis(const std::string& type, AnalysisFactoryWithRegistry factory, TypeInfo info);
+
+  // --- choices inside plugins and analyses (see ChoiceFactory) ---------------
+  /// Registers `type` in `family`; throws if it is already registered, or if
+  /// the family was registered with another Base or Context.
+  template <class Base, class Context = NoContext>
+  void addChoice(const std::string& family, const std::string& type,
+                 typename detail::NonDeduced<ChoiceFactory<Base, Context>>::type factory, TypeInfo info) {
+    if (!factory) throw Error(family + " factory for '" + type + "' is empty");
+    addChoiceErased(family, type, typeid(ChoiceFactory<Base, Context>).name(),
+                    std::make_shared<ChoiceFactory<Base, Context>>(std::move(factory)), std::move(info));
+  }
+  /// Creates `type` of `family`. Throws Error "<where>: unknown <family> '<type>';
+  /// known: ..." (family with blanks for underscores; no prefix if `where` is
+  /// empty) if there is none.
+  template <class Base, class Context = NoContext>
+  std::unique_ptr<Base> createChoice(const std::string& family, const std::string& type, const ParamReader& params,
+                                     const Context& context, const std::string& where) const {
+    const auto* f = static_cast<const ChoiceFactory<Base, Context>*>(
+        choiceFactory(family, type, typeid(ChoiceFactory<Base, Context>).name(), where));
+    auto made = (*f)(params, context);
+    if (!made) throw Error((where.empty() ? "" : where + ": ") + family + " '" + type + "' factory returned nothing");
+    return made;
+  }
+  bool hasChoice(const std::string& family, const std::string& type) const;
+  /// The families registered, sorted.
+  std::vector<std::string> choiceFamilies() const;
+  /// Sorted type names of one family (empty if the family is unknown).
+  std::vector<std::string> knownChoices(const std::string& family) const;
+  const TypeInfo& choiceInfo(const std::string& family, const std::string& type) const;
+
  private:
   void requireNew(PluginKind kind, const std::string& type) const;
   [[noreturn]] void unknown(PluginKind kind, const std::string& type, const std::string& where) const;
   std::map<std::pair<PluginKind, std::string>, Factory> factories_;
   std::map<std::string, VehicleFactory> vehicles_;
-  std::map<std::string, AnalysisFactory> analyses_;
+  std::map<std::string, AnalysisFactoryWithRegistry> analyses_;
   std::map<std::pair<PluginKind, std::string>, TypeInfo> infos_;
+  struct Choice {
+    std::string signature;                 ///< mangled ChoiceFactory<Base, Context> type
+    std::shared_ptr<const void> factory;   ///< a ChoiceFactory<Base, Context>
+    TypeInfo info;
+  };
+  void addChoiceErased(const std::string& family, const std::string& type, const std::string& signature,
+                       std::shared_ptr<const void> factory, TypeInfo info);
+  const void* choiceFactory(const std::string& family, const std::string& type, const std::string& signature,
+                            const std::string& where) const;
+  std::map<std::pair<std::string, std::string>, Choice> choices_;
+  std::map<std::string, std::string> familySignatures_;
 };
 
 /// Every kind, in the order `vdyn list` prints them.

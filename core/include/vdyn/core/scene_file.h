@@ -52,6 +52,12 @@ struct BuiltScene {
 
   Scene& scene() { return vehicle->updScene(); }
   const Scene& scene() const { return vehicle->getScene(); }
+  /// The concrete vehicle (e.g. FourWsVehicle) for code that needs its own
+  /// C++ API; throws Error if the scene's vehicle is another (Vehicle::getConcrete).
+  template <class V>
+  V& vehicleAs() { return vehicle->getConcrete<V>(); }
+  template <class V>
+  const V& vehicleAs() const { return vehicle->getConcrete<V>(); }
   /// The vehicle's initial state at initial_speed_m_s.
   SimTK::State makeInitialState() const { return vehicle->makeInitialState(initial_speed_m_s); }
 };

@@ -1,13 +1,14 @@
 #pragma once
-// Design models of the vehicles (chapter 4 sensitivity, plugins/sensitivity):
-// named handles into their parameter structs. They live with the vehicles, so
-// the sensitivity plugin depends on core only.
+// The quarter car's design model with all its 20 parameters as handles into
+// QuarterCarParams (the ch4_sensitivity_cost benchmark's parameter-count sweep,
+// the sensitivity tests). The studies differentiate scenes (SceneDesign,
+// plugins/analyses): the chapter 4 model is scenes/ch4_sensitivity.json, the
+// 4WS one scenes/ch4_sensitivity_fourws.json.
 #include <memory>
 #include <string>
 #include <vector>
 
 #include "vdyn/sensitivity/design.h"
-#include "vdyn/vehicles/fourws.h"
 #include "vdyn/vehicles/quarter_car.h"
 
 namespace vdyn {
@@ -36,33 +37,6 @@ class QuarterCarDesign : public DesignModel {
  private:
   QuarterCarParams nominal_;
   std::vector<FieldHandle<QuarterCarParams>> handles_;
-};
-
-/// The App. A 4WS vehicle in the chapter 3 manoeuvre (constant speed, front and
-/// rear smooth steer steps). Parameters: chassis.mass_kg, front.spring.stiffness_N_per_m,
-/// front.spring.damping_N_s_per_m, rear.spring.stiffness_N_per_m,
-/// rear.spring.damping_N_s_per_m, tire.radial_stiffness_N_per_m (front values
-/// apply to both front corners, rear to both rear corners).
-struct FourWsManoeuvre {
-  double speed_m_s = 10;
-  double front_angle_rad = 0.06981317007977318;  ///< 4 deg, + left
-  double rear_angle_rad = 0.017453292519943295;  ///< 1 deg
-  double steer_start_time_s = 0.5;
-  double steer_duration_s = 1.0;
-};
-
-class FourWsDesign : public DesignModel {
- public:
-  FourWsDesign(const FourWsParams& nominal, const FourWsManoeuvre& manoeuvre);
-  std::string describe() const override { return "4ws vehicle"; }
-
- protected:
-  std::unique_ptr<DesignInstance> DoBuild(const std::vector<double>& b) const override;
-
- private:
-  FourWsParams nominal_;
-  FourWsManoeuvre manoeuvre_;
-  std::vector<FieldHandle<FourWsParams>> handles_;
 };
 
 }  // namespace vdyn

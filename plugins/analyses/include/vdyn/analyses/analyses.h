@@ -63,11 +63,26 @@ Json summarizeTransient(const BuiltScene& built, const TransientSettings& settin
 class SceneDesign : public DesignModel {
  public:
   SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params);
+  /// Parameters named apart from where they live: params[i] is the value at
+  /// scene key path keyPaths[i]. `heldData` (a merge patch over the vehicle
+  /// data, e.g. Vehicle::derivedData() of the nominal design) is applied to
+  /// every design before the parameters: values the vehicle derives from a
+  /// rule are then data (a datum) held at their nominal values.
+  SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params,
+              std::vector<std::string> keyPaths, const Json& heldData);
+  /// The design model a sensitivity analysis of the scene differentiates: the
+  /// scene's "analysis" (type sensitivity) with its "parameters" (key paths,
+  /// or objects {"path", "name", "symbol", "unit", "scale"}), "scales" and
+  /// "derived_data" (nominal: builds the nominal scene once and holds what
+  /// its vehicle derived). Throws Error naming the key.
+  static std::shared_ptr<SceneDesign> fromAnalysis(const SceneDescription& scene);
   /// Parameters at the scene's nominal values (scale = |nominal|, or 1 if 0);
   /// throws Error naming a path that is not a number in the scene or data file.
   static std::vector<DesignParameter> parametersOf(const SceneDescription& scene,
                                                    const std::vector<std::string>& keyPaths);
   std::string describe() const override { return "scene '" + scene_.name() + "'"; }
+  /// The scene key path of each parameter (getParameters() order).
+  const std::vector<std::string>& keyPaths() const { return paths_; }
 
  protected:
   std::unique_ptr<DesignInstance> DoBuild(const std::vector<double>& values) const override;
@@ -75,6 +90,7 @@ class SceneDesign : public DesignModel {
  private:
   SceneDescription scene_;
   std::vector<std::string> paths_;
+  std::vector<Override> held_;
 };
 
 /// Registers every built-in analysis.

@@ -84,12 +84,27 @@ class NonlinearKrStrategy : public RearSteerStrategy {
   KrTable table_;
 };
 
-/// Names accepted by makeRearSteerStrategy: 2ws, linear, nonlinear.
+/// What a strategy's factory receives besides its parameters (family
+/// "rear_steer_strategy" of the registry, registry.h ChoiceFactory).
+struct RearSteerContext {
+  LinearBicycleParams linear;       ///< the plugin's linear bicycle (defaults: chapter 6 values)
+  const KrTable* table = nullptr;   ///< the plugin's Kr coefficient table, if it names one
+};
+
+/// The built-in strategies: 2ws, linear, nonlinear (in this order).
 const std::vector<std::string>& rearSteerStrategyNames();
-/// Throws Error naming `name` and the known ones if unknown, or if
-/// "nonlinear" is asked without a table.
+/// Registers 2ws, linear and nonlinear in family "rear_steer_strategy" (Base
+/// RearSteerStrategy, context RearSteerContext); an out-of-tree library adds
+/// its own with registry.addChoice<RearSteerStrategy, RearSteerContext>(...).
+void registerRearSteerStrategies(PluginRegistry& registry);
+/// The strategy registered as `name` (in `registry`, or the built-ins if
+/// nullptr); `params` is the rear_steer plugin's entry (the strategy may read
+/// keys of its own), or none. Throws Error naming `name` and the known ones
+/// if unknown, or if "nonlinear" is asked without a table.
 std::shared_ptr<const RearSteerStrategy> makeRearSteerStrategy(const std::string& name, const LinearBicycleParams& linear,
-                                                               const KrTable* table);
+                                                               const KrTable* table,
+                                                               const PluginRegistry* registry = nullptr,
+                                                               const ParamReader* params = nullptr);
 
 /// Tracking gains of (8.5)/(8.8).
 struct RearSteerParams {
@@ -148,7 +163,7 @@ class RearSteerPlugin : public ControllerPlugin {
   std::shared_ptr<const RearSteerLaw> law_;
 };
 
-/// Registers "rear_steer": {"rear_steering": "rear_steer", "front_steering":
+/// Registers "rear_steer" (and the strategies, registerRearSteerStrategies): {"rear_steering": "rear_steer", "front_steering":
 /// "front_steer", "chassis": "chassis", "strategy": "linear", "g1_per_s2": 10,
 /// "g2_per_s": 10, "linear_bicycle": {...} (optional, chapter 6 values by
 /// default), "kr_table": "file.json" (nonlinear only)}.

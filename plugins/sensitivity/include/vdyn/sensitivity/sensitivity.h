@@ -24,6 +24,7 @@
 #include <vector>
 
 #include "vdyn/core/integrators.h"
+#include "vdyn/core/registry.h"
 #include "vdyn/sensitivity/cost.h"
 #include "vdyn/sensitivity/design.h"
 
@@ -101,11 +102,18 @@ class SensitivityMethod {
   SensitivitySettings settings_;
 };
 
-/// "fd_forward", "fd_central", "mixed", "reference".
+/// The built-in methods, in the order studies print them: "fd_forward",
+/// "fd_central", "mixed", "reference".
 const std::vector<std::string>& sensitivityMethodNames();
-/// Throws Error listing the known names if `name` is unknown.
+/// Registers the built-in methods in family "sensitivity_method" (Base
+/// SensitivityMethod, context SensitivitySettings); an out-of-tree library adds
+/// its own with registry.addChoice<SensitivityMethod, SensitivitySettings>(...).
+void registerSensitivityMethods(PluginRegistry& registry);
+/// The method registered as `name` (in `registry`, or the built-ins if
+/// nullptr). Throws Error listing the known names if `name` is unknown.
 std::unique_ptr<SensitivityMethod> makeSensitivityMethod(const std::string& name,
-                                                         const SensitivitySettings& settings = {});
+                                                         const SensitivitySettings& settings = {},
+                                                         const PluginRegistry* registry = nullptr);
 
 /// One simulation of the problem's model at design `b` (all parameters of the
 /// model): builds the scene, adds the cost, makes the initial state, integrates

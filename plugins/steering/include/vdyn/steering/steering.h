@@ -115,11 +115,20 @@ struct SteeringStateSpec {
   void validate(const std::string& where) const;
 };
 
+/// A command by its registered "type" (family "steering_command"):
 /// {"type": "hold", "angle_rad": 0}, {"type": "smooth_step", "initial_rad": 0,
 /// "final_rad": 0.0698, "start_time_s": 0.5, "duration_s": 1.0}, or
 /// {"type": "steps", "initial_rad": 0, "steps": [{"start_time_s": 0.5,
-/// "duration_s": 0.5, "change_rad": 0.035}, ...]}.
-std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r);
+/// "duration_s": 0.5, "change_rad": 0.035}, ...]}, or one an out-of-tree
+/// library registered. `registry` nullptr = the built-in commands only.
+std::shared_ptr<const SteeringCommand> makeSteeringCommand(const ParamReader& r,
+                                                           const PluginRegistry* registry = nullptr);
+
+/// Registers the commands hold, smooth_step and steps in family
+/// "steering_command" (Base SteeringCommand, context NoContext); an
+/// out-of-tree library adds its own with
+/// registry.addChoice<SteeringCommand>("steering_command", "my_cmd", factory, info).
+void registerSteeringCommands(PluginRegistry& registry);
 
 /// The constraint of one wheel on a steer body D (state-driven steering):
 /// Phi = x_B . (s_F - y_D) = 0.
@@ -247,7 +256,7 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
 /// the knuckles to the commanded angle rather than the command to the knuckles.
 std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene);
 
-/// Registers "steering": {"chassis": "chassis", "knuckles": ["rf.knuckle", "lf.knuckle"],
+/// Registers "steering" (and the commands, registerSteeringCommands): {"chassis": "chassis", "knuckles": ["rf.knuckle", "lf.knuckle"],
 /// "spin_axis": [0, 1, 0], "command": {...}} (chassis and knuckles may be bound).
 /// A command {"type": "state", "initial_rad": 0} makes it state-driven (a
 /// controller plugin then sets its law).
