@@ -1,8 +1,11 @@
 // Run time against error for the chapter 3 transient of the 4WS vehicle
-// (ch3_transient's manoeuvre), for both corner models (constrained: the loops
-// and steering closed by constraint rows; reduced: the loops solved in the
-// knuckle's mobilizer), each integrator at accuracies 1e-3 .. 1e-8 against a
-// reference at 1e-10 of the same model.
+// (ch3_transient's manoeuvre), for three models (constrained: the loops and
+// steering closed by constraint rows; reduced: the loops solved in the
+// knuckle's mobilizer, its arm, steering and speed rows solved by Simbody;
+// dense: the reduced model with those rows solved as one dense system,
+// FourWsVehicle::useDenseRows), each integrator at accuracies 1e-3 .. 1e-8
+// against a reference at 1e-10 of the same model (the dense model's errors
+// against the reduced model's reference, which Simbody projects).
 //
 // Per run: steps, forward-dynamics evaluations (integrator realizations), CPU
 // time (std::clock: this process's CPU, not wall time), real-time factor
@@ -38,6 +41,7 @@ struct Run {
   std::vector<double> yaw, roll;
   RunSummary sum;
   double cpu_s = 0;
+  double perr = 0, verr = 0;  ///< dense model: its rows' largest errors at the end
 };
 
 /// The scene of `model` (composed from the scene file, like ch3_transient),
@@ -56,11 +60,13 @@ Setup makeSetup(const study::Ch3Case& ch3, const std::string& model) {
   if (model == "constrained") {
     st.built = std::move(con);
     st.initial = s0;
-  } else {
-    st.built = ch3.build(model);
+  } else {  // "reduced", or "dense": the reduced model with its rows solved densely
+    st.built = ch3.build("reduced");
     st.initial = st.built.vehicleAs<FourWsVehicle>().makeStateLike(con.vehicleAs<FourWsVehicle>(), s0);
   }
   st.car = &st.built.vehicleAs<FourWsVehicle>();
+  if (model == "dense") st.car->useDenseRows(st.initial);
+  st.car->getScene().getSystem().realize(st.initial, SimTK::Stage::Velocity);
   return st;
 }
 
@@ -80,6 +86,10 @@ Run runCh3(const study::Ch3Case& ch3, const std::string& model, const std::strin
   const double c0 = cpuNow();
   r.sum = simulate(st.car->getScene(), s, sim, &rec);
   r.cpu_s = cpuNow() - c0;
+  if (model == "dense") {
+    st.car->getScene().getSystem().realize(s, SimTK::Stage::Velocity);
+    std::tie(r.perr, r.verr) = st.car->denseRows()->calcRowErrors(s);
+  }
   r.yaw = rec.column("chassis.yaw_rate_rad_s");
   r.roll = rec.column("chassis.roll_rad");
   return r;
@@ -111,6 +121,7 @@ std::pair<double, double> evaluationCost(const study::Ch3Case& ch3, const std::s
   };
   const double withRows = time(st.initial);
   SimTK::State free = st.initial;
+  if (st.car->denseRows()) st.car->denseRows()->setActive(free, false);
   const SimTK::SimbodyMatterSubsystem& m = st.car->getScene().getMatter();
   for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(free);
   const double tree = time(free);
@@ -123,7 +134,9 @@ int main(int argc, char** argv) {
     namespace po = study::po;
     po::options_description opts("Options");
     opts.add_options()("data", po::value<std::string>()->default_value("scenes/ch3_transient.json"), "scene file of the manoeuvre")(
-        "models", po::value<std::string>()->default_value("constrained,reduced"), "comma-separated corner models")(
+        "models", po::value<std::string>()->default_value("constrained,reduced,dense"),
+        "comma-separated models: constrained, reduced (rows solved by Simbody), dense (the reduced model's rows "
+        "solved densely, FourWsVehicle::useDenseRows)")(
         "integrators", po::value<std::string>()->default_value("rk_merson,rk3,rk_feldberg,cpodes"),
         "comma-separated integrator names")(
         "accuracies", po::value<std::string>()->default_value("1e-3,1e-4,1e-5,1e-6,1e-7,1e-8"), "comma-separated accuracies")(
@@ -131,6 +144,9 @@ int main(int argc, char** argv) {
         "repeats", po::value<int>()->default_value(5), "runs of each model at the data file's setting (medians)")(
         "cost-evaluations", po::value<int>()->default_value(300), "evaluations timed for the cost per evaluation")(
         "skip-sweep", "only the references, the cost per evaluation and the headline runs")(
+        "dense-accuracy", po::value<double>()->default_value(1e-6),
+        "accuracy of the dense model's headline runs (its integrator is the data file's): the loosest of the "
+        "sweep that keeps the yaw-rate history within 1e-6; the other models run at the data file's")(
         "report-interval-s", po::value<double>()->default_value(0.05), "sampling interval of the histories, s")(
         "t-end-s", po::value<double>()->default_value(20.0), "simulated time, s")("no-plots", "skip the PNG plot");
     const auto vm = study::parse("ch3_work_precision", "4WS chapter 3 transient: run time against error", argc, argv, opts);
@@ -141,7 +157,7 @@ int main(int argc, char** argv) {
     const double refAcc = vm["reference-accuracy"].as<double>();
     const std::vector<std::string> models = bench::splitList(vm["models"].as<std::string>());
     for (const auto& m : models)
-      if (m != "constrained" && m != "reduced") throw Error("--models: unknown corner model '" + m + "'");
+      if (m != "constrained" && m != "reduced" && m != "dense") throw Error("--models: unknown corner model '" + m + "'");
 
     std::map<std::string, Run> ref;
     for (const auto& m : models) {
@@ -149,6 +165,16 @@ int main(int argc, char** argv) {
       std::printf("reference %-11s: rk_merson at %g, %d steps, %.2f s CPU; final yaw rate %.10f rad/s\n", m.c_str(),
                   refAcc, ref[m].sum.steps, ref[m].cpu_s, ref[m].yaw.back());
     }
+    // Errors of the dense model are measured against the reduced model's
+    // reference (its rows solved by Simbody and projected), when it runs.
+    auto refOf = [&](const std::string& m) -> const Run& {
+      return m == "dense" && ref.count("reduced") ? ref["reduced"] : ref[m];
+    };
+    if (ref.count("dense") && ref.count("reduced"))
+      std::printf("references: dense against reduced, yaw rate %.2e, roll %.2e; dense rows at the end: position %.1e, "
+                  "velocity %.1e\n",
+                  relErr(ref["dense"].yaw, ref["reduced"].yaw), relErr(ref["dense"].roll, ref["reduced"].roll),
+                  ref["dense"].perr, ref["dense"].verr);
     if (ref.count("constrained") && ref.count("reduced"))
       std::printf("references: reduced against constrained, yaw rate %.2e, roll %.2e (relative max deviation)\n",
                   relErr(ref["reduced"].yaw, ref["constrained"].yaw), relErr(ref["reduced"].roll, ref["constrained"].roll));
@@ -160,10 +186,11 @@ int main(int argc, char** argv) {
     for (const auto& m : models) {
       const auto [withRows, tree] = evaluationCost(ch3, m, nEval);
       Setup st = makeSetup(ch3, m);
+      const int nRows = m == "dense" ? st.car->denseRows()->numRows() : st.initial.getNUDotErr();
       std::printf("%-12s %16.1f %16.1f %8.2f %6d %6d\n", m.c_str(), withRows * 1e6, tree * 1e6, withRows / tree,
-                  st.initial.getNU(), st.initial.getNUDotErr());
+                  st.initial.getNU(), nRows);
       cost[m] = {{"evaluation_cpu_s", withRows}, {"tree_only_cpu_s", tree}, {"ratio", withRows / tree},
-                 {"nu", st.initial.getNU()}, {"constraint_rows", st.initial.getNUDotErr()}};
+                 {"nu", st.initial.getNU()}, {"constraint_rows", nRows}};
     }
 
     // Headline: the data file's setting, models alternately, medians.
@@ -172,20 +199,22 @@ int main(int argc, char** argv) {
     std::map<std::string, Run> last;
     for (int k = 0; k < repeats; ++k)
       for (const auto& m : models) {
-        last[m] = runCh3(ch3, m, ch3.sim.integrator.method, ch3.sim.integrator.accuracy, tEnd);
+        last[m] = runCh3(ch3, m, ch3.sim.integrator.method,
+                         m == "dense" ? vm["dense-accuracy"].as<double>() : ch3.sim.integrator.accuracy, tEnd);
         cpu[m].push_back(last[m].cpu_s);
       }
     Json headline = Json::object();
-    std::printf("\nheadline: %s at %g, %d runs each (medians of CPU time)\n", ch3.sim.integrator.method.c_str(),
-                ch3.sim.integrator.accuracy, repeats);
+    std::printf("\nheadline: %s at %g (dense at %g), %d runs each, alternately (medians of CPU time)\n",
+                ch3.sim.integrator.method.c_str(), ch3.sim.integrator.accuracy, vm["dense-accuracy"].as<double>(),
+                repeats);
     std::printf("%-12s %7s %7s %10s %8s %11s %11s\n", "model", "steps", "evals", "CPU (s)", "RTF", "err yaw", "err roll");
     for (const auto& m : models) {
       const double med = bench::median(cpu[m]);
       const Run& r = last[m];
-      const double ey = relErr(r.yaw, ref[m].yaw), er = relErr(r.roll, ref[m].roll);
+      const double ey = relErr(r.yaw, refOf(m).yaw), er = relErr(r.roll, refOf(m).roll);
       std::printf("%-12s %7d %7d %10.3f %8.1f %11.2e %11.2e\n", m.c_str(), r.sum.steps, r.sum.realizations, med,
                   r.sum.sim_time_s / med, ey, er);
-      headline[m] = {{"steps", r.sum.steps}, {"evaluations", r.sum.realizations}, {"cpu_time_s_median", med},
+      headline[m] = {{"accuracy", m == "dense" ? vm["dense-accuracy"].as<double>() : ch3.sim.integrator.accuracy}, {"steps", r.sum.steps}, {"evaluations", r.sum.realizations}, {"cpu_time_s_median", med},
                      {"cpu_time_s", cpu[m]}, {"real_time_factor", r.sum.sim_time_s / med}, {"error_yaw_rate", ey},
                      {"error_roll", er}};
     }
@@ -193,6 +222,18 @@ int main(int argc, char** argv) {
       const double ratio = bench::median(cpu["constrained"]) / bench::median(cpu["reduced"]);
       std::printf("same-run ratio constrained / reduced CPU time: %.2f\n", ratio);
       headline["ratio_constrained_over_reduced"] = ratio;
+    }
+    if (cpu.count("dense")) {
+      const double md = bench::median(cpu["dense"]);
+      std::printf("dense rows at the end: position error %.1e rad, velocity error %.1e\n", last["dense"].perr,
+                  last["dense"].verr);
+      for (const char* m : {"constrained", "reduced"})
+        if (cpu.count(m)) {
+          std::printf("same-run ratio %s / dense CPU time: %.2f\n", m, bench::median(cpu[m]) / md);
+          headline[std::string("ratio_") + m + "_over_dense"] = bench::median(cpu[m]) / md;
+        }
+      headline["dense"]["row_position_error_end"] = last["dense"].perr;
+      headline["dense"]["row_velocity_error_end"] = last["dense"].verr;
     }
 
     Json rows = Json::array();
@@ -215,7 +256,7 @@ int main(int argc, char** argv) {
               std::printf("%-12s %-12s %9.0e  failed: %s\n", model.c_str(), m.c_str(), acc, e.what());
               continue;
             }
-            const double ey = relErr(r.yaw, ref[model].yaw), er = relErr(r.roll, ref[model].roll);
+            const double ey = relErr(r.yaw, refOf(model).yaw), er = relErr(r.roll, refOf(model).roll);
             const double rtf = r.sum.sim_time_s / r.cpu_s;
             std::printf("%-12s %-12s %9.0e %7d %7d %10.3f %8.1f %11.2e %11.2e\n", model.c_str(), m.c_str(), acc,
                         r.sum.steps, r.sum.realizations, r.cpu_s, rtf, ey, er);

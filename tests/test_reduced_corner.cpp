@@ -256,3 +256,84 @@ TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
   EXPECT_NEAR(r[1].psi / r[0].psi, 1.0, 1e-6);
   EXPECT_NEAR(r[1].dpsi_db[0] / r[0].dpsi_db[0], 1.0, 1e-3);
 }
+
+// Dense forward dynamics (reduced_dense.h): the same accelerations as
+// Simbody's rows in the same state, the same transient, rows held.
+TEST(ReducedDense, SameAccelerationsAsSimbodysRowsInTheSameState) {
+  const auto red = ch3Car("reduced", "appendix_a_relaxation.json", false);
+  const SimTK::MultibodySystem& sys = red->getScene().getSystem();
+  SimTK::State s = red->makeInitialState(10.0);
+  SimulationSettings sim;
+  sim.t_end_s = 1.0;  // mid steering step: turning, rolling, steering rates non-zero
+  sim.integrator.accuracy = 1e-8;
+  sim.integrator.constraint_tolerance = 1e-10;
+  simulate(red->getScene(), s, sim, nullptr);
+  sys.project(s, 1e-14);  // on the constraint manifold: the Baumgarte terms vanish
+  SimTK::State d = s;
+  red->useDenseRows(d);
+  sys.realize(s, SimTK::Stage::Acceleration);
+  sys.realize(d, SimTK::Stage::Acceleration);
+  EXPECT_EQ(d.getNUDotErr(), 0);  // Simbody solves no row in the dense state
+  EXPECT_EQ(red->degreesOfFreedom(d), red->degreesOfFreedom(s));
+  const auto [perr, verr] = red->denseRows()->calcRowErrors(d);
+  EXPECT_LT(perr, 1e-12);
+  EXPECT_LT(verr, 1e-10);
+  const double scale = s.getUDot().normInf();
+  EXPECT_GT(scale, 1.0);
+  EXPECT_LT((d.getUDot() - s.getUDot()).normInf() / scale, 1e-8) << d.getUDot() << "\n" << s.getUDot();
+  const auto& hold = dynamic_cast<const SpeedHoldPlugin&>(*red->getScene().getPlugins().back());
+  EXPECT_NEAR(hold.calcForce(d), hold.calcForce(s), 1e-8 * std::abs(hold.calcForce(s)) + 1e-9);
+}
+
+TEST(ReducedDense, SameCh3TransientAsSimbodysRows) {
+  const auto red = ch3Car("reduced", "appendix_a_relaxation.json", false);
+  SimTK::State sr = red->makeInitialState(10.0);
+  SimTK::State sd = sr;
+  red->useDenseRows(sd);
+  SimulationSettings sim;
+  sim.t_end_s = 2.5;
+  sim.report_interval_s = 0.05;
+  sim.integrator.accuracy = 1e-8;
+  sim.integrator.constraint_tolerance = 1e-10;
+  const std::vector<std::string> cols = {"chassis.yaw_rate_rad_s", "chassis.roll_rad", "front_steer.angle_rad"};
+  Recorder rr(red->getScene(), cols), rd(red->getScene(), cols);
+  simulate(red->getScene(), sr, sim, &rr);
+  simulate(red->getScene(), sd, sim, &rd);
+  ASSERT_EQ(rr.size(), rd.size());
+  for (const auto& n : cols) {
+    double scale = 0, err = 0;
+    for (std::size_t i = 0; i < rr.size(); ++i) {
+      scale = std::max(scale, std::abs(rr.column(n)[i]));
+      err = std::max(err, std::abs(rr.column(n)[i] - rd.column(n)[i]));
+    }
+    EXPECT_GT(scale, 1e-3) << n;
+    EXPECT_LT(err / scale, 1e-6) << n;
+  }
+  red->getScene().getSystem().realize(sd, SimTK::Stage::Velocity);
+  const auto [perr, verr] = red->denseRows()->calcRowErrors(sd);
+  EXPECT_LT(perr, 1e-9);  // drift held by the Baumgarte terms
+  EXPECT_LT(verr, 1e-8);
+}
+
+TEST(ReducedDense, NeedsTheReducedModelAndTimeCommands) {
+  FourWsParams p = params("constrained");
+  p.forward_dynamics = "dense";
+  EXPECT_THROW(p.validate(), Error);
+  const auto con = ch3Car("constrained", "appendix_a.json", true);
+  SimTK::State s = con->makeInitialState(10.0);
+  EXPECT_THROW(con->useDenseRows(s), Error);
+  // A state-driven steering plugin is not a time command: named Error.
+  auto red = std::make_unique<FourWsVehicle>(params("reduced"));
+  struct Zero : SteeringLaw {
+    Zero() : SteeringLaw("zero") {}
+    double DoCalcAcceleration(const SimTK::State&) const override { return 0; }
+  };
+  red->addAxleSteering("front_steer", true, SteeringStateSpec{}).setAccelerationLaw(std::make_shared<Zero>());
+  SimTK::State sr = red->getScene().getDefaultState();
+  try {
+    red->useDenseRows(sr);
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("front_steer"), std::string::npos) << e.what();
+  }
+}

@@ -4,6 +4,7 @@
 
 #include "vdyn/core/simulation.h"
 #include "vdyn/plugins/builtin.h"
+#include "vdyn/speed/speed_hold.h"
 
 namespace vdyn {
 
@@ -25,6 +26,10 @@ void FourWsParams::validate() const {
   if (tire_plugin.empty()) throw Error("4ws tire plugin name is empty");
   if (corner_model != "constrained" && corner_model != "reduced")
     throw Error("4ws corner_model must be \"constrained\" or \"reduced\", got \"" + corner_model + "\"");
+  if (forward_dynamics != "simbody" && forward_dynamics != "dense")
+    throw Error("4ws forward_dynamics must be \"simbody\" or \"dense\", got \"" + forward_dynamics + "\"");
+  if (forward_dynamics == "dense" && corner_model != "reduced")
+    throw Error("4ws forward_dynamics \"dense\" needs corner_model \"reduced\" (got \"" + corner_model + "\")");
 }
 
 FourWsParams FourWsParams::fromParams(const ParamReader& r) {
@@ -38,6 +43,7 @@ FourWsParams FourWsParams::fromParams(const ParamReader& r) {
   if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
   p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
   p.corner_model = r.stringOr("corner_model", p.corner_model);
+  p.forward_dynamics = r.stringOr("forward_dynamics", p.forward_dynamics);
   if (p.corner_model != "constrained" && p.corner_model != "reduced")
     throw Error(r.where() + ": corner_model must be \"constrained\" or \"reduced\", got \"" + p.corner_model + "\"");
   r.requireAllKeysRead();
@@ -91,6 +97,8 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
       rows.insert(rows.end(), r.begin(), r.end());
     }
     SimTK::Constraint::Custom(new ArmPlanesImpl(sc.updMatter(), rows));
+    dense_ = new ReducedDenseRows(sc.getMatter(), sc.getForces());
+    SimTK::Force::Custom(sc.updForces(), dense_);  // inactive until useDenseRows()
   }
   addChassisOutputs(sc, chassis_);
 }
@@ -123,7 +131,8 @@ double FourWsVehicle::totalMass() const {
 int FourWsVehicle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
   // A state-driven steering plugin's steer body moves by a prescribed acceleration.
-  return s.getNU() - s.getNUDotErr() - static_cast<int>(steeringStateBodies(*scene_).size());
+  const int denseRows = dense_ && dense_->isActive(s) ? dense_->numRows() : 0;  // rows Simbody does not see
+  return s.getNU() - s.getNUDotErr() - denseRows - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
 SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* report) const {
@@ -150,6 +159,7 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
     // initial angles), read into the reduced coordinates.
     FourWsParams cp = p_;
     cp.corner_model = "constrained";
+    cp.forward_dynamics = "simbody";
     FourWsVehicle con(cp, *registry_);
     for (const AxleSteering& a : axleSteering_)
       con.addAxleSteering(a.name, a.front,
@@ -189,6 +199,10 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
   for (int c = 0; c < 4; ++c) scene_->getBody(std::string(cornerName(c)) + ".wheel").setOneU(s, 0, spin[c]);
   system.realize(s, SimTK::Stage::Velocity);
   for (const TirePlugin* t : tires_) t->getForceElement().initializeRelaxationStates(s);
+  if (p_.forward_dynamics == "dense") {
+    useDenseRows(s);
+    system.realize(s, SimTK::Stage::Velocity);
+  }
   return s;
 }
 
@@ -248,8 +262,55 @@ SimTK::State FourWsVehicle::makeStateLike(const FourWsVehicle& other, const SimT
   s.updZ() = os.getZ();
   system.realize(s, SimTK::Stage::Position);
   system.project(s, 1e-12);
+  if (p_.forward_dynamics == "dense") useDenseRows(s);
   system.realize(s, SimTK::Stage::Velocity);
   return s;
+}
+
+void FourWsVehicle::useDenseRows(SimTK::State& s) const {
+  if (!reduced_) throw Error("4ws: dense forward dynamics needs corner_model \"reduced\"");
+  const Scene& sc = *scene_;
+  std::vector<ReducedDenseRows::Arm> arms;
+  for (int c = 0; c < 4; ++c)
+    arms.push_back({reducedCorners_[c].lower_arm, reducedCorners_[c].upper_arm, reducedCorners_[c].knuckle,
+                    loops_[c].get()});
+  std::vector<ReducedDenseRows::Steer> steers;
+  std::vector<ReducedDenseRows::Speed> speeds;
+  const std::string why = " (forward_dynamics \"dense\" solves only time-commanded steering of the knuckles and "
+                          "speed holds on the chassis; use forward_dynamics \"simbody\")";
+  for (const auto& plugin : sc.getPlugins()) {
+    if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get())) {
+      if (st->isStateDriven()) throw Error("4ws: steering plugin '" + plugin->name() + "' is state-driven" + why);
+      if (sc.getBody(st->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
+        throw Error("4ws: steering plugin '" + plugin->name() + "' is not on the chassis" + why);
+      for (const std::string& k : st->knuckleBodies()) {
+        int c = 0;
+        while (c < 4 && std::string(cornerName(c)) + ".knuckle" != k) ++c;
+        if (c == 4) throw Error("4ws: steering plugin '" + plugin->name() + "' steers '" + k + "', not a knuckle" + why);
+        if ((st->spinAxis().asVec3() - SimTK::UnitVec3(cornerParams_[c].wheel_spin_axis).asVec3()).norm() > 1e-12)
+          throw Error("4ws: steering plugin '" + plugin->name() + "' measures (A.1) about another spin axis than " + k +
+                      "'s" + why);
+        steers.push_back({reducedCorners_[c].knuckle, st->sharedCommand()});
+      }
+    } else if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get())) {
+      if (sc.getBody(sp->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
+        throw Error("4ws: speed hold '" + plugin->name() + "' is not on the chassis" + why);
+      const ReducedDenseRows* dense = dense_;
+      const int k = int(speeds.size());
+      sp->setDisabledForceSource([dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); });
+      speeds.push_back({chassis_, sp});
+    }
+  }
+  dense_->setRows(std::move(arms), std::move(steers), std::move(speeds));
+  const SimTK::MultibodySystem& system = sc.getSystem();
+  if (dense_->isActive(s)) return;
+  system.realize(s, SimTK::Stage::Instance);
+  if (s.getNUDotErr() != dense_->numRows())
+    throw Error("4ws: the scene has " + std::to_string(s.getNUDotErr()) + " constraint rows, the dense path solves " +
+                std::to_string(dense_->numRows()) + why);
+  const SimTK::SimbodyMatterSubsystem& m = sc.getMatter();
+  for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(s);
+  dense_->setActive(s, true);
 }
 
 }  // namespace vdyn

@@ -105,6 +105,7 @@ void SpeedHoldPlugin::setEnabled(SimTK::State& s, bool enabled) const {
 double SpeedHoldPlugin::calcForce(const SimTK::State& s) const {
   // Simbody applies -G^T lambda; along the (unit at U0) direction of travel the
   // force on the chassis is therefore -lambda.
+  if (disabledForce_ && constraint_.isDisabled(s)) return disabledForce_(s);
   return -constraint_.getMultipliersAsVector(s)[0];
 }
 

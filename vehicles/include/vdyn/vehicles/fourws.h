@@ -16,6 +16,7 @@
 #include "vdyn/tire/tire_force.h"
 #include "vdyn/vehicles/double_wishbone.h"
 #include "vdyn/vehicles/quarter_car.h"
+#include "vdyn/vehicles/reduced_dense.h"
 #include "vdyn/vehicles/reduced_wishbone.h"
 
 namespace vdyn {
@@ -38,6 +39,12 @@ struct FourWsParams {
   /// the knuckle's mobilizer, q = [s, delta]; see reduced_wishbone.h). Both
   /// describe the same mechanism with the same bodies.
   std::string corner_model = "constrained";
+  /// Data-file key "forward_dynamics" (reduced model only): "simbody"
+  /// (default; the constraint rows solved by Simbody, projected each step) or
+  /// "dense" (the same rows solved as one dense system per evaluation, with
+  /// Baumgarte drift control; time-commanded steering only; see
+  /// reduced_dense.h). makeInitialState and makeStateLike return dense states.
+  std::string forward_dynamics = "simbody";
 
   void validate() const;
   /// Reads a vehicle data file in the layout of appendix_a.json.
@@ -88,6 +95,15 @@ class FourWsVehicle {
   /// their rates, time and z variables (same plugins in the same order).
   /// The arm angles follow from s; the state is projected to the constraints.
   SimTK::State makeStateLike(const FourWsVehicle& other, const SimTK::State& os) const;
+  /// Reduced model only: switches `s` to dense forward dynamics (see
+  /// reduced_dense.h): every constraint row of the scene (arm rows, the
+  /// steering plugins' time-commanded rows, speed holds) is disabled in `s`
+  /// and solved by ReducedDenseRows instead. Throws Error (naming it) for a
+  /// row it cannot solve (a state-driven steering plugin, any other
+  /// constraint). Call after every plugin has been added.
+  void useDenseRows(SimTK::State& s) const;
+  /// The dense rows' force element (reduced model; null on the constrained one).
+  const ReducedDenseRows* denseRows() const { return dense_; }
   const TirePlugin& tire(int c) const { return *tires_.at(c); }
   const DoubleWishboneParams& cornerParams(int c) const { return cornerParams_.at(c); }
 
@@ -100,6 +116,7 @@ class FourWsVehicle {
   bool reduced_ = false;
   std::array<std::unique_ptr<WishboneLoop>, 4> loops_;
   std::array<ReducedWishboneCorner, 4> reducedCorners_;
+  ReducedDenseRows* dense_ = nullptr;  ///< owned by its Force::Custom
   std::shared_ptr<const PluginRegistry> registry_;  ///< reduced: for the constrained copy
   struct AxleSteering {
     std::string name;

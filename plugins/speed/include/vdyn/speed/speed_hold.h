@@ -5,6 +5,7 @@
 // m/s. Its force acts at the chassis origin along (v_xi e_xi + v_eta e_eta) / U0
 // (the constraint's gradient), and its multiplier is the force it takes to hold
 // the speed: output <name>.force_N (> 0 propulsive, N).
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -52,6 +53,8 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   SpeedHoldPlugin(std::string name, std::string chassisBody, double speed_m_s);
   /// The default speed (the one a new state holds), m/s.
   double speed() const { return U0_; }
+  /// Name of the chassis body whose speed is held.
+  const std::string& chassisBody() const { return chassis_; }
   /// The speed held in `s`, and a way to change it without rebuilding the scene
   /// (continuation in speed); valid once the plugin is in a scene.
   double getSpeed(const SimTK::State& s) const;
@@ -62,6 +65,12 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   /// Force the constraint applies along the direction of travel, N (needs
   /// Stage::Acceleration).
   double calcForce(const SimTK::State& s) const;
+  /// For a model that solves this row itself with the constraint disabled in
+  /// its states (FourWsVehicle::useDenseRows): calcForce reads the force from
+  /// `force` (N, same sign) in a state where the constraint is disabled.
+  void setDisabledForceSource(std::function<double(const SimTK::State&)> force) const {
+    disabledForce_ = std::move(force);
+  }
 
  protected:
   void DoAddTo(Scene& scene) override;
@@ -74,6 +83,7 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   double U0_;
   SimTK::Constraint::Custom constraint_;
   const SpeedHoldImpl* impl_ = nullptr;
+  mutable std::function<double(const SimTK::State&)> disabledForce_;
 };
 
 /// Registers "speed_hold": {"chassis": "chassis", "speed_m_s": 10}.

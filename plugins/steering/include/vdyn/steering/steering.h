@@ -210,6 +210,14 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
                  const SteeringStateSpec& state, SimTK::UnitVec3 spinAxis_K = SimTK::UnitVec3(SimTK::YAxis));
   /// The time command (throws Error for a state-driven plugin).
   const SteeringCommand& command() const;
+  /// The time command as shared (null for a state-driven plugin).
+  std::shared_ptr<const SteeringCommand> sharedCommand() const { return command_; }
+  /// Names of the chassis and knuckle bodies and the knuckle's spin axis (K
+  /// frame): what a vehicle that solves the steering rows itself needs
+  /// (FourWsVehicle::useDenseRows).
+  const std::string& chassisBody() const { return chassis_; }
+  const std::vector<std::string>& knuckleBodies() const { return knuckles_; }
+  const SimTK::UnitVec3& spinAxis() const { return spin_K_; }
 
   /// State-driven only: the steer body (added to the scene as <name>.steer).
   const SimTK::MobilizedBody::Pin& getSteerBody() const;

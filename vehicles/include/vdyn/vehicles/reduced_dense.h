@@ -1,0 +1,120 @@
+#pragma once
+// Dense forward dynamics for the reduced 4WS vehicle: its constraint rows (the
+// eight arm rows of ArmPlanesImpl, one steering row per steered knuckle with a
+// time command, the speed hold (3.18)) solved as one small dense KKT system
+// instead of Simbody's per-row path (calcGMInvGt: one pass over every
+// constraint object per row, 55 % of the instructions with the rows in
+// Simbody, issue 13).
+//
+// The rows, written on the reduced coordinates (q_L, q_U the lower and upper
+// arm Pin angles, s and delta the knuckle's mobilities):
+//   lower arm   q_L - s = 0              (the lower arm's angle is s)
+//   upper arm   q_U - theta4(s) = 0      (WishboneLoop::calcUpperArmAngle)
+//   steering    delta - delta_cmd(t) = 0 (the knuckle's delta is the angle of
+//               (A.1) by construction, so this is the steering constraint)
+//   speed hold  (v_xi^2 + v_eta^2 - U0^2) / (2 U0) = 0 (SpeedHoldImpl's row)
+// They are the same constraints as the Simbody rows (a point in the arm's
+// plane through its pivot axis holds exactly when the arm's angle is the
+// loop's), so the equations of motion are the same. Per evaluation, with the
+// applied forces f (every force element's, summed by Simbody) and M, G, b:
+//   udot0 = M^-1 (f - c)                (calcAccelerationIgnoringConstraints)
+//   Y     = M^-1 G^T                    (one multiplyByMInv per row)
+//   (G Y) lambda = b - G udot0          (dense Cholesky, m <= 13)
+// and G^T lambda is added to the mobility forces, so Simbody's own tree
+// solve returns udot = udot0 + Y lambda, which meets G udot = b.
+//
+// Simbody does not know these rows, so it does not project onto them; their
+// drift is held by Baumgarte terms (b - 2 w verr - w^2 perr for the holonomic
+// rows, b - w verr for the speed hold, w = kBaumgarteRate_per_s), which vanish
+// on the constraint manifold. The drift stays at the integrator's error
+// level (ch3_work_precision reports it).
+//
+// Active only in a state where FourWsVehicle::useDenseRows() set its flag
+// (and disabled the Simbody constraints it replaces); in every other state
+// this force does nothing and the Simbody rows act. Simbody's constraint
+// multipliers are not available in a dense state; the speed hold's force
+// (speed_hold.force_N) is read from this element (speedHoldForce).
+// Not thread-safe (workspace in the object), as ReducedKnuckleMobilizer.
+#include <memory>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "vdyn/steering/steering.h"
+#include "vdyn/vehicles/reduced_wishbone.h"
+
+namespace vdyn {
+
+class SpeedHoldPlugin;
+
+class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
+ public:
+  static constexpr double kBaumgarteRate_per_s = 50.0;
+
+  ReducedDenseRows(const SimTK::SimbodyMatterSubsystem& matter, const SimTK::GeneralForceSubsystem& forces)
+      : matter_(&matter), forces_(&forces) {}
+
+  /// The rows (set by FourWsVehicle::useDenseRows before the first dense state).
+  struct Arm {
+    SimTK::MobilizedBody::Pin lower, upper;
+    SimTK::MobilizedBody::Custom knuckle;
+    const WishboneLoop* loop = nullptr;
+  };
+  struct Steer {
+    SimTK::MobilizedBody::Custom knuckle;
+    std::shared_ptr<const SteeringCommand> command;
+  };
+  struct Speed {
+    SimTK::MobilizedBody::Free chassis;
+    const SpeedHoldPlugin* plugin = nullptr;
+  };
+  void setRows(std::vector<Arm> arms, std::vector<Steer> steers, std::vector<Speed> speeds);
+  int numRows() const { return int(arms_.size() * 2 + steers_.size() + speeds_.size()); }
+
+  bool isActive(const SimTK::State& s) const;
+  void setActive(SimTK::State& s, bool active) const;
+
+  /// Largest position error of the holonomic rows (rad) and velocity error of
+  /// every row (rad/s; m/s for the speed hold) in `s` (Stage::Velocity).
+  std::pair<double, double> calcRowErrors(const SimTK::State& s) const;
+  /// Force of the k-th speed hold along the direction of travel, N
+  /// (SpeedHoldPlugin::calcForce's sign), in a dense state (Stage::Dynamics).
+  double speedHoldForce(const SimTK::State& s, int k) const;
+
+  // Force::Custom::Implementation
+  void calcForce(const SimTK::State&, SimTK::Vector_<SimTK::SpatialVec>&, SimTK::Vector_<SimTK::Vec3>&,
+                 SimTK::Vector&) const override {}
+  SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+  bool dependsOnlyOnPositions() const override { return false; }
+  void realizeTopology(SimTK::State& s) const override;
+  /// Runs after every force element's calcForce (GeneralForceSubsystem calls
+  /// realizeDynamics of its forces once the sums are complete): adds G^T lambda.
+  void realizeDynamics(const SimTK::State& s) const override;
+
+ private:
+  /// One row: sparse G (u index, coefficient), the right side b of G udot = b
+  /// (with the Baumgarte terms), and the errors.
+  struct RowEval {
+    int n = 0;
+    int u[3];
+    double g[3];
+    double b = 0, perr = 0, verr = 0;
+  };
+  void evalRows(const SimTK::State& s) const;
+
+  const SimTK::SimbodyMatterSubsystem* matter_;
+  const SimTK::GeneralForceSubsystem* forces_;
+  std::vector<Arm> arms_;
+  std::vector<Steer> steers_;
+  std::vector<Speed> speeds_;
+  mutable SimTK::DiscreteVariableIndex activeIndex_;
+  mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
+  // Workspace.
+  mutable std::vector<RowEval> rows_;
+  mutable SimTK::Vector udot0_, v_;
+  mutable std::vector<SimTK::Vector> Y_;
+  mutable SimTK::Vector_<SimTK::SpatialVec> A_GB_;
+  mutable std::vector<double> A_, r_;
+};
+
+}  // namespace vdyn
