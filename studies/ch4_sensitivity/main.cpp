@@ -61,6 +61,9 @@ int main(int argc, char** argv) {
     // file); its sensitivity analysis names the design parameters, and the
     // study's options become scene overrides.
     const ParamReader study = vehicle == "quarter_car" ? data : data.child("fourws");
+    // The other vehicle's case: not read here, not unknown.
+    if (vehicle == "quarter_car") data.has("fourws");
+    else for (const char* k : {"scene", "design_parameters"}) data.has(k);
     std::vector<Override> overrides;
     bool relaxation = false;
     const ParamReader relax = data.child("tire_relaxation");
