@@ -31,6 +31,18 @@ void requireColumn(const Table& t, const std::string& table, const std::string& 
     throw Error("plot '" + plot + "': table '" + table + "' has no column '" + col + "'");
 }
 
+/// True if column `c` has a finite value in a row where column `x` has one
+/// (gnuplot fails on a plot whose points are all undefined).
+bool hasPoints(const Table& t, std::size_t x, std::size_t c) {
+  for (const auto& r : t.rows)
+    if (x < r.size() && c < r.size() && std::isfinite(r[x]) && std::isfinite(r[c])) return true;
+  return false;
+}
+
+std::size_t columnIndex(const Table& t, const std::string& c) {
+  return std::size_t(std::find(t.columns.begin(), t.columns.end(), c) - t.columns.begin());
+}
+
 void runGnuplot(const std::string& png, const std::string& script) {
   const std::string gp = png + ".gp";
   {
@@ -68,32 +80,41 @@ std::vector<std::string> renderPlots(const std::string& dir, const std::vector<s
     if (p.equal_axes) s += "set size ratio -1\n";
     if (p.logx) s += "set logscale x\n";
     s += "plot ";
+    int drawn = 0;
     for (std::size_t i = 0; i < p.series.size(); ++i) {
       const PlotSeries& q = p.series[i];
       const Table& t = findTable(tables, q.table, p.name);
       requireColumn(t, q.table, q.x, p.name);
       requireColumn(t, q.table, q.y, p.name);
       named.insert(q.table);
-      s += std::string(i ? ", \\\n     " : "") + quote(dir + "/" + q.table + ".csv") + " using (column(" +
+      if (!hasPoints(t, columnIndex(t, q.x), columnIndex(t, q.y))) continue;  // nothing to draw
+      s += std::string(drawn++ ? ", \\\n     " : "") + quote(dir + "/" + q.table + ".csv") + " using (column(" +
            quote(q.x) + ")):(column(" + quote(q.y) + "))" + (p.points ? " with linespoints lw 2 pt 7" : " with lines lw 2") +
            " title " + quote(q.label.empty() ? q.y : q.label);
     }
+    if (drawn == 0) continue;
     const std::string png = dir + "/" + p.name + ".png";
     runGnuplot(png, s + "\n");
     written.push_back(png);
   }
   for (const auto& [name, t] : tables) {
     if (named.count(name) || t.columns.size() < 2 || t.rows.empty()) continue;
-    const int n = std::min<int>(int(t.columns.size()) - 1, maxPanels);
-    const int cols = n <= 3 ? 1 : (n <= 8 ? 2 : 3), rows = (n + cols - 1) / cols;
-    std::string s = "set multiplot layout " + std::to_string(rows) + "," + std::to_string(cols) + " title " +
-                    quote(name + (int(t.columns.size()) - 1 > n ? " (first " + std::to_string(n) + " columns)" : "")) +
+    std::vector<std::size_t> cols;  // the columns with points to draw
+    for (std::size_t c = 1; c < t.columns.size(); ++c)
+      if (hasPoints(t, 0, c)) cols.push_back(c);
+    if (cols.empty()) continue;
+    const int n = std::min<int>(int(cols.size()), maxPanels);
+    const int nc = n <= 3 ? 1 : (n <= 8 ? 2 : 3), rows = (n + nc - 1) / nc;
+    std::string s = "set multiplot layout " + std::to_string(rows) + "," + std::to_string(nc) + " title " +
+                    quote(name + (int(cols.size()) > n ? " (first " + std::to_string(n) + " columns)" : "")) +
                     " noenhanced\nset key off\n";
-    for (int i = 1; i <= n; ++i)
+    for (int k = 0; k < n; ++k) {
+      const std::size_t i = cols[k];
       s += "set title " + quote(t.columns[i]) + " noenhanced\nset xlabel " + quote(t.columns[0]) +
            " noenhanced\nplot " + quote(dir + "/" + name + ".csv") + " using (column(" + quote(t.columns[0]) +
            ")):(column(" + quote(t.columns[i]) + "))" + (t.rows.size() < 40 ? " with linespoints pt 7" : " with lines") +
            " lw 2\n";
+    }
     s += "unset multiplot\n";
     const std::string png = dir + "/" + name + ".png";
     runGnuplot(png, s);

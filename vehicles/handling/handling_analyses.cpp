@@ -439,6 +439,7 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
         {"abort_path_error_m", "m", "2", "a run this far off the path stops and fails"},
         {"spin_limit_rad", "rad", "0.5", "|side slip| beyond this: spin-out, fails"},
         {"sample_s", "s", "0.005", "sampling of the motion (cone check)"},
+        {"max_steps", "", "40000", "integrator steps a run may take (beyond: stopped, fails)"},
         {"integrator", "-", "rk_merson 1e-6", "integrator settings"}}});
   registry.addAnalysis(
       "vehicle_report", [](const ParamReader& r) { return std::make_unique<VehicleReportAnalysis>(r); },

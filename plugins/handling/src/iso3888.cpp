@@ -138,6 +138,7 @@ void Iso3888Settings::validate() const {
   requirePositive(abort_path_error_m, "ISO 3888-2 abort_path_error_m");
   requirePositive(spin_limit_rad, "ISO 3888-2 spin_limit_rad");
   requirePositive(sample_s, "ISO 3888-2 sample_s");
+  if (max_steps < 1) throw Error("ISO 3888-2 max_steps must be >= 1, got " + std::to_string(max_steps));
 }
 
 Iso3888Settings Iso3888Settings::fromParams(const ParamReader& r) {
@@ -157,6 +158,7 @@ Iso3888Settings Iso3888Settings::fromParams(const ParamReader& r) {
   s.abort_path_error_m = r.numberOr("abort_path_error_m", s.abort_path_error_m);
   s.spin_limit_rad = r.numberOr("spin_limit_rad", s.spin_limit_rad);
   s.sample_s = r.numberOr("sample_s", s.sample_s);
+  s.max_steps = int(r.numberOr("max_steps", s.max_steps));
   if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
   s.validate();
   return s;
@@ -240,8 +242,12 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     struct LeftTheCourse {};
     const double xStop = L.endX() + set.lead_out_m;
     const auto wall0 = std::chrono::steady_clock::now();
+    int steps = 0;
     try {
       out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
+        if (++steps > set.max_steps)
+          throw Error("more than max_steps = " + std::to_string(set.max_steps) + " integrator steps by t = " +
+                      formatValue(st.getTime()) + " s");
         const double d = scene.evalOutput(dist, st);
         if (!(std::abs(d) <= set.abort_path_error_m))
           throw Error("lost the path: " + formatValue(d) + " m from it at t = " + formatValue(st.getTime()) + " s");
@@ -253,6 +259,7 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
       });
     } catch (const LeftTheCourse&) {
       out.run.sim_time_s = rec.time().empty() ? 0.0 : rec.time().back();
+      out.run.steps = steps;
       out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     }
     out.t_s = rec.time();

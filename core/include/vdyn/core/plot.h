@@ -16,7 +16,8 @@ bool gnuplotAvailable();
 /// Renders `plots` (their tables already written as <out_dir>/<table>.csv)
 /// and, for every table no plot names, a default plot: each column against
 /// the first, one panel per column (at most `max_panels`, the rest listed in
-/// the title). Returns the PNG paths written. Throws Error if gnuplot is
+/// the title). Columns and series without a finite point are left out (a
+/// plot with none is not drawn). Returns the PNG paths written. Throws Error if gnuplot is
 /// missing or fails, or a plot names a table or column that is not there.
 std::vector<std::string> renderPlots(const std::string& out_dir,
                                      const std::vector<std::pair<std::string, Table>>& tables,
