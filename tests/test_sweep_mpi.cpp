@@ -8,6 +8,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <unistd.h>
+
 #include "vdyn/core/sweep_mpi.h"
 
 using namespace vdyn;
@@ -46,7 +48,10 @@ int main(int argc, char** argv) {
       ],
       "collect": ["y", "third", "n"]})"),
                                                           "mpi_test.json:", "");
-    const std::string dir = std::filesystem::temp_directory_path().string() + "/vdyn_test_sweep_mpi";
+    // One folder per mpirun: its ranks share their parent (mpirun), concurrent test runs do not
+    // (a fixed name let two runs share one journal, and the second resumed the first's rows).
+    const std::string dir = std::filesystem::temp_directory_path().string() + "/vdyn_test_sweep_mpi_" +
+                            std::to_string(static_cast<long>(getppid()));
     if (mpi.rank() == 0) std::filesystem::remove_all(dir);
     SweepOptions o;
     o.out_dir = dir;
