@@ -53,28 +53,33 @@ TEST(Iso4138, LinearTireBicycleUndersteerGradientIsTheClosedForm) {
 }
 
 TEST(Iso4138, LongTransientEndsOnTheConstantRadiusSteadyState) {
-  auto b = bike("gim");
-  ConstantRadiusSettings set;
-  set.radius_m = 40;
-  set.speed_start_m_s = set.speed_max_m_s = 12;  // a_y = 3.6 m/s^2
-  set.stability = false;
-  const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
-  ASSERT_EQ(r.points.size(), 1u);
-  const ConstantRadiusPoint& p = r.points[0];
-  // The transient from straight running with the solved angle held.
-  b->vehicle.holdSteering(12, p.front_rad);
-  IntegratorSettings integ;
-  integ.accuracy = 1e-8;
-  const HandlingHistory h = runHandlingTransient(b->vehicle, 12, 15.0, 0.5, integ);
-  const double rT = h.yaw_rate_rad_s.back(), ayT = h.lateral_accel_m_s2.back();
-  std::printf("front %.6f deg: yaw rate steady %.9f transient %.9f; a_y %.9f / %.9f; side slip %.9f / %.9f; roll %.9g / %.9g\n",
-              p.front_rad / kDeg, p.yaw_rate_rad_s, rT, p.lateral_accel_m_s2, ayT, p.side_slip_rad,
-              h.side_slip_rad.back(), p.roll_rad, h.roll_rad.back());
-  EXPECT_NEAR(rT, p.yaw_rate_rad_s, 1e-5 * p.yaw_rate_rad_s);
-  EXPECT_NEAR(ayT, p.lateral_accel_m_s2, 1e-5 * p.lateral_accel_m_s2);
-  EXPECT_NEAR(h.side_slip_rad.back(), p.side_slip_rad, 1e-5 * std::abs(p.side_slip_rad));
-  // Path radius of the transient: U / r.
-  EXPECT_NEAR(12.0 / rT, 40.0, 40.0 * 1e-5);
+  // Three points of the R = 40 m sweep (a_y = 1.6, 3.6 and 4.9 m/s^2): the constant-radius
+  // steady state against a long transient from straight running with the solved angle held.
+  for (const double speed : {8.0, 12.0, 14.0}) {
+    SCOPED_TRACE("speed " + std::to_string(speed) + " m/s");
+    auto b = bike("gim");
+    ConstantRadiusSettings set;
+    set.radius_m = 40;
+    set.speed_start_m_s = set.speed_max_m_s = speed;
+    set.stability = false;
+    const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
+    ASSERT_EQ(r.points.size(), 1u);
+    const ConstantRadiusPoint& p = r.points[0];
+    b->vehicle.holdSteering(speed, p.front_rad);
+    IntegratorSettings integ;
+    integ.accuracy = 1e-8;
+    const HandlingHistory h = runHandlingTransient(b->vehicle, speed, 15.0, 0.5, integ);
+    const double rT = h.yaw_rate_rad_s.back(), ayT = h.lateral_accel_m_s2.back();
+    std::printf("%.0f m/s, front %.6f deg: yaw rate steady %.9f transient %.9f; a_y %.9f / %.9f; "
+                "side slip %.9f / %.9f; roll %.9g / %.9g\n",
+                speed, p.front_rad / kDeg, p.yaw_rate_rad_s, rT, p.lateral_accel_m_s2, ayT, p.side_slip_rad,
+                h.side_slip_rad.back(), p.roll_rad, h.roll_rad.back());
+    EXPECT_NEAR(rT, p.yaw_rate_rad_s, 1e-5 * p.yaw_rate_rad_s);
+    EXPECT_NEAR(ayT, p.lateral_accel_m_s2, 1e-5 * p.lateral_accel_m_s2);
+    EXPECT_NEAR(h.side_slip_rad.back(), p.side_slip_rad, 1e-5 * std::abs(p.side_slip_rad));
+    // Path radius of the transient: U / r.
+    EXPECT_NEAR(speed / rT, 40.0, 40.0 * 1e-5);
+  }
 }
 
 TEST(Iso7401, FrequencyResponseMatchesSineSteerSimulations) {
