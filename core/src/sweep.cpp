@@ -794,17 +794,12 @@ std::function<void(const SweepProgress&)> sweepProgressPrinter(const std::string
   };
 }
 
-// --- the thread runner ------------------------------------------------------------
-SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, const SweepOptions& o) {
-  if (o.threads < 1) throw Error("sweep: --threads must be at least 1, got " + std::to_string(o.threads));
-  const auto t0 = std::chrono::steady_clock::now();
-  const double cpu0 = processCpuSeconds();
+std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
+                                         std::FILE*& journal) {
   const std::size_t n = d.variations.size();
-  SweepResult res;
-  res.runner = "threads";
   res.rows.resize(n);
   std::vector<char> have(n, 0);
-  std::FILE* journal = nullptr;
+  journal = nullptr;
   if (!o.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(o.out_dir, ec);
@@ -822,6 +817,19 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
   std::vector<std::size_t> pending;
   for (std::size_t i = 0; i < n; ++i)
     if (!have[i]) pending.push_back(i);
+  return pending;
+}
+
+// --- the thread runner ------------------------------------------------------------
+SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, const SweepOptions& o) {
+  if (o.threads < 1) throw Error("sweep: --threads must be at least 1, got " + std::to_string(o.threads));
+  const auto t0 = std::chrono::steady_clock::now();
+  const double cpu0 = processCpuSeconds();
+  const std::size_t n = d.variations.size();
+  SweepResult res;
+  res.runner = "threads";
+  std::FILE* journal = nullptr;
+  const std::vector<std::size_t> pending = prepareSweepRun(d, o, res, journal);
 
   std::mutex mu;
   SweepProgress prog;

@@ -97,25 +97,9 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   // --- manager (rank 0) ------------------------------------------------------------
   const int localThreads = size == 1 ? std::max(1, o.threads) : o.threads;
   const std::size_t n = d.variations.size();
-  res.rows.resize(n);
-  std::vector<char> have(n, 0);
   std::FILE* journal = nullptr;
-  if (!o.out_dir.empty()) {
-    std::error_code ec;
-    std::filesystem::create_directories(o.out_dir, ec);
-    if (ec) throw Error("cannot create output folder '" + o.out_dir + "': " + ec.message());
-    if (o.resume)
-      for (SweepRow& r : readSweepJournal(d, o.out_dir)) {
-        if (!r.ok && o.retry_failed) continue;
-        have[r.index] = 1;
-        res.rows[r.index] = std::move(r);
-        ++res.resumed;
-      }
-    journal = openSweepJournal(o.out_dir, o.resume);
-  }
-  std::deque<std::size_t> queue;
-  for (std::size_t i = 0; i < n; ++i)
-    if (!have[i]) queue.push_back(i);
+  const std::vector<std::size_t> pending = prepareSweepRun(d, o, res, journal);
+  std::deque<std::size_t> queue(pending.begin(), pending.end());
   const std::size_t pendingCount = queue.size();
 
   SweepProgress prog;

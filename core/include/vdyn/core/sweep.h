@@ -215,6 +215,13 @@ std::vector<SweepRow> readSweepJournal(const SweepDescription& d, const std::str
 /// Opens `dir`/runs.jsonl for appending (resume) or anew; a last line without
 /// its line break gets one first.
 std::FILE* openSweepJournal(const std::string& dir, bool append);
+/// Prepares a run of `d` for either runner: sizes `res.rows`, creates `o.out_dir`,
+/// takes the rows already in its journal (o.resume; failed ones again if
+/// o.retry_failed) into `res.rows` and `res.resumed`, and opens the journal into
+/// `journal` (nullptr when o.out_dir is ""). Returns the variation indices still to run,
+/// ascending.
+std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
+                                         std::FILE*& journal);
 /// results.csv text: variation,status,<keys>,<collect>,reason.
 std::string formatSweepCsv(const SweepDescription& d, const std::vector<SweepRow>& rows);
 /// results.json text.
