@@ -357,3 +357,37 @@ TEST(SceneAnalyses, ContinuationAgreesWithSteadyState) {
   EXPECT_GT(r12, r10);
   EXPECT_EQ(co["points"][1]["value"].get<double>(), 12.0);
 }
+
+// A reduced 4WS vehicle built from a scene file (corner_model "reduced" as a
+// vehicle override, steering plugins from the registry) starts from the same
+// state as the same composition in C++ (FourWsVehicle::addAxleSteering): the
+// constrained copy it is assembled from carries the scene's steering holds
+// (front 0.05 rad, rear 0.02 rad), so positions and speeds agree bit for bit.
+TEST(SceneFile, ReducedFourWsStartsLikeTheCxxCompositionWithItsSteeringHolds) {
+  Json extra = R"({"vehicle": {"overrides": {"corner_model": "reduced"}}})"_json;
+  Json j = smallScene(extra).json();
+  j["plugins"].insert(j["plugins"].begin() + 1, R"({"type": "steering", "name": "rear_steer", "attach": "rear_axle",
+                                                    "command": {"type": "hold", "angle_rad": 0.02}})"_json);
+  const BuiltScene built = SceneDescription::fromJson(j, "small.json", standardRegistry()).build();
+  ASSERT_TRUE(built.vehicleAs<FourWsVehicle>().isReduced());
+  const SimTK::State ss = built.makeInitialState();
+
+  FourWsParams p = FourWsParams::fromFile("appendix_a.json");
+  p.corner_model = "reduced";
+  FourWsVehicle car(p);
+  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.05));
+  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.02));
+  car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
+  const SimTK::State cs = car.makeInitialState(10.0);
+
+  ASSERT_EQ(ss.getNQ(), cs.getNQ());
+  ASSERT_EQ(ss.getNU(), cs.getNU());
+  double dq = 0, du = 0;
+  for (int i = 0; i < ss.getNQ(); ++i) dq = std::max(dq, std::abs(ss.getQ()[i] - cs.getQ()[i]));
+  for (int i = 0; i < ss.getNU(); ++i) du = std::max(du, std::abs(ss.getU()[i] - cs.getU()[i]));
+  EXPECT_EQ(dq, 0.0);
+  EXPECT_EQ(du, 0.0);
+  // The knuckles' steering coordinates are the holds (q = [s, delta]).
+  for (int c : {RF, LF}) EXPECT_NEAR(car.reducedCorner(c).knuckle.getOneQ(cs, 1), 0.05, 1e-9);
+  for (int c : {RR, LR}) EXPECT_NEAR(car.reducedCorner(c).knuckle.getOneQ(cs, 1), 0.02, 1e-9);
+}

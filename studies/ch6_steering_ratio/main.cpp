@@ -23,6 +23,7 @@
 #include <thread>
 
 #include "study.h"
+#include "vdyn/analyses/branch_analyses.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 #include "vdyn/vehicles/standard_registry.h"
@@ -85,6 +86,7 @@ struct SpeedRun {
   int passes = 0;                       // 2 when refined
   int extra_solves = 0, extra_newton = 0;  // of the first pass, when refined
   std::vector<OptimalRatioPoint> points;
+  Json summary;                         // the optimal_ratio analysis's summary of the last pass
   std::vector<double> yaw_rate_rad_s;   // per point (NaN without a state)
   double wall_time_s = 0;
 };
@@ -165,29 +167,38 @@ int main(int argc, char** argv) {
 
     // --- Figure 6.4: nonlinear map, one thread per speed -------------------------
     const FourWsParams params = FourWsParams::fromFile(vm["data"].as<std::string>());
-    const SceneDescription sceneBase =
-        SceneDescription::fromFile("scenes/ch6_steering_ratio.json", standardRegistry(),
-                                   {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}});
-    SteadyStateOptions sso;
-    // Converging solves here take about 4 iterations; a failing one (beyond the
-    // branch's end) spends all of them, most with a fresh Jacobian: 30, not 60.
-    sso.max_iterations = vm["max-newton-iterations"].as<int>();
-    if (sso.max_iterations < 1)
-      throw Error("--max-newton-iterations must be at least 1, got " + std::to_string(sso.max_iterations));
-    sso.force_tolerance = requirePositive(vm["force-tolerance-n"].as<double>(), "--force-tolerance-n");
-    sso.fresh_jacobian_each_solve = vm.count("fresh-jacobian") > 0;
-    OptimalRatioOptions oro;
-    oro.check_stability = vm.count("no-stability") == 0;
-    oro.max_bisections = vm["bisections"].as<int>();
-    oro.end_bisections = vm["end-bisections"].as<int>();
-    if (oro.end_bisections < 0)
-      throw Error("--end-bisections must be non-negative, got " + std::to_string(oro.end_bisections));
-    if (oro.max_bisections < 0) throw Error("--bisections must be non-negative, got " + std::to_string(oro.max_bisections));
-    oro.stability_skip_margin_per_s =
+    // Validated here with the option names; the values go to the scene's
+    // optimal_ratio analysis (one code path with `vdyn run`).
+    const int maxIterations = vm["max-newton-iterations"].as<int>();
+    if (maxIterations < 1) throw Error("--max-newton-iterations must be at least 1, got " + std::to_string(maxIterations));
+    const double forceTolerance = requirePositive(vm["force-tolerance-n"].as<double>(), "--force-tolerance-n");
+    const bool freshJacobian = vm.count("fresh-jacobian") > 0;
+    const int bisections = vm["bisections"].as<int>(), endBisections = vm["end-bisections"].as<int>();
+    if (endBisections < 0) throw Error("--end-bisections must be non-negative, got " + std::to_string(endBisections));
+    if (bisections < 0) throw Error("--bisections must be non-negative, got " + std::to_string(bisections));
+    const double skipMargin =
         requireNonNegative(vm["stability-skip-margin-per-s"].as<double>(), "--stability-skip-margin-per-s");
-    oro.stability_skip_max = vm["stability-skip-max"].as<int>();
-    if (oro.stability_skip_max < 0)
-      throw Error("--stability-skip-max must be non-negative, got " + std::to_string(oro.stability_skip_max));
+    const int skipMax = vm["stability-skip-max"].as<int>();
+    if (skipMax < 0) throw Error("--stability-skip-max must be non-negative, got " + std::to_string(skipMax));
+    std::vector<double> gridRad;
+    for (double d : frontsDeg) gridRad.push_back(d * kDeg);
+    // The composition and the analysis are the scene's
+    // (scenes/ch6_steering_ratio.json: held front and rear steering, speed
+    // hold, optimal_ratio), with this program's options as its settings; each
+    // speed builds it as `vdyn run` does and runs OptimalRatioAnalysis::follow.
+    const SceneDescription sceneBase = SceneDescription::fromFile(
+        "scenes/ch6_steering_ratio.json", standardRegistry(),
+        {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())},
+         {"analysis.linear_bicycle", ParamReader::fromFile(vm["linear-data"].as<std::string>()).json()},
+         {"analysis.front_angles_rad", gridRad},
+         {"analysis.max_iterations", maxIterations},
+         {"analysis.force_tolerance_N", forceTolerance},
+         {"analysis.fresh_jacobian", freshJacobian},
+         {"analysis.check_stability", vm.count("no-stability") == 0},
+         {"analysis.bisections", bisections},
+         {"analysis.end_bisections", endBisections},
+         {"analysis.stability_skip_margin_per_s", skipMargin},
+         {"analysis.stability_skip_max", skipMax}});
     std::vector<SpeedRun> runs(speeds.size());
     // One variation per speed through the sweep runner (vdyn/core/sweep.h):
     // threads take speeds one at a time; a speed's full result stays in runs[i]
@@ -207,34 +218,19 @@ int main(int argc, char** argv) {
         const auto ts = std::chrono::steady_clock::now();
         try {
           const double U = speeds[i];
-          // The composition is the scene (scenes/ch6_steering_ratio.json: held
-          // front and rear steering, speed hold) at this speed, built as
-          // `vdyn run` does; the steering angles change through the plugins'
-          // adjustable angle_rad (continuation without rebuilding).
           const BuiltScene built = sceneBase
                                        .withOverrides({{"vehicle.initial_speed_m_s", U},
                                                        {"plugins.speed_hold.speed_m_s", U}})
                                        .build();
           const Scene& sc = built.scene();
-          const Plugin& front = *sc.findPlugin<Plugin>("front_steer");
-          const Plugin& rear = *sc.findPlugin<Plugin>("rear_steer");
-          const Plugin& hold = *sc.findPlugin<Plugin>("speed_hold");
-          SteadyStateSolver solver(
-              sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0), sso);
-          SimTK::State s0 = built.makeInitialState();
-          hold.setAdjustable(s0, "speed_m_s", U);
-          const SteadyStateResult straight = solver.solve(s0);  // front 0: straight running
-          const SetSteering steer = [&](SimTK::State& st, double f, double r) {
-            front.setAdjustable(st, "angle_rad", f);
-            rear.setAdjustable(st, "angle_rad", r);
-          };
-          const SideSlipOf slip = [&](const SimTK::State& s) { return sc.evalOutput("chassis.side_slip_rad", s); };
-          const double kr0 = std::clamp(calcLinearOptimalRatio(lin, U), -1.0, 1.0);
+          const OptimalRatioAnalysis& analysis = OptimalRatioAnalysis::fromScene(built);
           auto follow = [&](const std::vector<double>& deg) {
             std::vector<double> rad;
             for (double d : deg) rad.push_back(d * kDeg);
             run.front_deg = deg;
-            run.points = followOptimalRatio(solver, straight, rad, kr0, steer, slip, oro);
+            const OptimalRatioRun r = analysis.follow(built, &rad);
+            run.summary = analysis.summarize(r);
+            run.points = r.points;
             ++run.passes;
           };
           // Grid: where the linear bicycle at zero side slip reaches the friction
@@ -297,45 +293,48 @@ int main(int argc, char** argv) {
     Json fitJson = Json::array(), perSpeed = Json::array();
     long solves = 0, newton = 0, krIterations = 0, mapPoints = 0;
     std::printf("  nonlinear map (6.12)-(6.15), %d threads, %s Jacobian per solve\n", threads,
-                sso.fresh_jacobian_each_solve ? "fresh" : "Broyden-reused");
+                freshJacobian ? "fresh" : "Broyden-reused");
     std::printf("  %6s %8s %10s %12s %9s %6s %11s %9s %7s\n", "U m/s", "C1", "C2 /deg^2", "rms", "points", "infeas",
                 "max deg", "linear", "wall s");
     for (const SpeedRun& run : runs) {
       const double U = run.speed_m_s, linKr = calcLinearOptimalRatio(lin, U);
-      std::vector<double> fd, kr;
-      int infeasible = 0;
-      double largest = 0;
       solves += run.extra_solves;
       newton += run.extra_newton;
       for (std::size_t k = 0; k < run.points.size(); ++k) {
         const OptimalRatioPoint& p = run.points[k];
-        solves += p.solves;
-        newton += p.newton_iterations;
-        krIterations += p.kr_iterations;
         const double deg = p.front_rad / kDeg;
         f << U << ',' << deg << ',' << toString(p.status) << ',';
         if (p.status == OptimalRatioStatus::NoSteadyState) {
           f << ',' << linKr << ",,,,,,,," << p.solves << ',' << p.newton_iterations << ',' << csvText(p.failure) << '\n';
           continue;
         }
-        ++mapPoints;
-        largest = deg;
-        if (p.status == OptimalRatioStatus::ZeroSideSlip) {
-          fd.push_back(deg);
-          kr.push_back(p.kr);
-        } else {
-          ++infeasible;
-        }
         const double r = run.yaw_rate_rad_s[k];
         f << p.kr << ',' << linKr << ',' << p.side_slip_rad << ',' << r << ',' << U * r << ',' << (p.stable ? 1 : 0)
           << ',' << (p.stability_checked ? 1 : 0) << ',' << (p.stability_checked ? formatValue(p.least_damped_real_per_s) : "") << ',' << p.kr_iterations << ',' << p.solves << ','
           << p.newton_iterations << ',' << csvText(p.failure) << '\n';
       }
+      // The aggregates are the optimal_ratio analysis's summary (what `vdyn
+      // run scenes/ch6_steering_ratio.json` writes at this speed).
+      const Json& sum = run.summary;
+      solves += sum.at("steady_state_solves").get<long>();
+      newton += sum.at("newton_iterations").get<long>();
+      krIterations += sum.at("kr_iterations").get<long>();
+      mapPoints += sum.at("map_points").get<long>();
+      const int infeasible = sum.at("infeasible_points").get<int>();
+      const double largest = sum.at("largest_front_deg").get<double>();
+      if (!sum.contains("fit")) {
+        int zero = 0;
+        for (const auto& p : run.points) zero += p.status == OptimalRatioStatus::ZeroSideSlip;
+        throw Error("at " + formatValue(U) + " m/s fewer than 2 front angles have a zero side slip steady state (" +
+                    std::to_string(zero) + "): no fit (8.1)");
+      }
+      const Json& fj = sum.at("fit");
       RatioFit fit;
-      fit.speed_m_s = U;
-      if (fd.size() >= 2) fit = fitRatio(U, fd, kr);
-      else throw Error("at " + formatValue(U) + " m/s fewer than 2 front angles have a zero side slip steady state (" +
-                       std::to_string(fd.size()) + "): no fit (8.1)");
+      fit.speed_m_s = fj.at("speed_m_s").get<double>();
+      fit.c1 = fj.at("c1").get<double>();
+      fit.c2_per_deg2 = fj.at("c2_per_deg2").get<double>();
+      fit.rms_residual = fj.at("rms_residual").get<double>();
+      fit.points = fj.at("points").get<int>();
       fits.push_back(fit);
       fitJson.push_back({{"speed_m_s", U},
                          {"c1", fit.c1},
@@ -384,7 +383,7 @@ int main(int argc, char** argv) {
                                              {"newton_iterations_per_solve", perSolve},
                                              {"kr_iterations", krIterations},
                                              {"threads", threads},
-                                             {"fresh_jacobian_each_solve", sso.fresh_jacobian_each_solve},
+                                             {"fresh_jacobian_each_solve", freshJacobian},
                                              {"speeds", perSpeed},
                                              {"wall_time_s", wall}});
     std::printf("  map: %ld points in %.2f s wall (%d threads; %.2f s CPU): %ld steady-state solves, %.2f Newton "

@@ -19,6 +19,7 @@
 #include "path_study.h"
 #include "study.h"
 #include "vdyn/core/events.h"
+#include "vdyn/core/plugin_library.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/core/sweep.h"
@@ -175,7 +176,12 @@ int main(int argc, char** argv) {
         "Kr coefficient table for the nonlinear strategy (JSON: delta_f_unit deg, fit [{speed_m_s, c1, "
         "c2_per_deg2}]); default: the data file's kr_table")(
         "scenario", po::value<std::string>(), "comma-separated scenario ids to run (default: all)")(
-        "strategy", po::value<std::string>(), "comma-separated strategies: 2ws, linear, nonlinear (default: all)")(
+        "strategy", po::value<std::string>(),
+        "comma-separated rear_steer_strategy names: the built-ins 2ws, linear, nonlinear, or one a --plugin library "
+        "registers (`vdyn list rear_steer_strategy`); default: the three built-ins")(
+        "plugin", po::value<std::vector<std::string>>()->composing(),
+        "load an out-of-tree plugin library (repeatable; vdyn/core/plugin_library.h), e.g. one that registers a "
+        "rear_steer_strategy")(
         "lane-change-length", po::value<std::string>(),
         "how the seed's lane-change distance reads: 'full' (the whole lane change, X_f - X_0; docs/equations.md) or "
         "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
@@ -186,6 +192,9 @@ int main(int argc, char** argv) {
     const auto vm = study::parse("ch8_maneuvers",
                                  "lane changes and J-turns of the 4WS vehicle under three rear-steer strategies (ch. 8)",
                                  argc, argv, opts);
+    PluginRegistry& registry = standardRegistry();
+    if (vm.count("plugin"))
+      for (const auto& lib : vm["plugin"].as<std::vector<std::string>>()) loadPluginLibrary(lib, registry);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
     const std::string vehicleData = resolveDataPath(data.string("vehicle_data"));
     FourWsParams::fromFile(vehicleData);  // a bad vehicle file is an error before any run
@@ -199,7 +208,7 @@ int main(int argc, char** argv) {
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
     const SceneDescription scene = SceneDescription::fromFile(
-        "scenes/ch8_maneuvers.json", standardRegistry(),
+        "scenes/ch8_maneuvers.json", registry,
         {{"vehicle.data", vehicleData},
          {"plugins.rear_control.kr_table", resolveDataPath(tablePath)},
          {"plugins.rear_control.linear_bicycle", data.child("linear_bicycle").json()}});
@@ -246,10 +255,19 @@ int main(int argc, char** argv) {
       }
       scenarios = chosen;
     }
+    // Strategies by name from the registry the scene is built with (a --plugin
+    // library's strategies included): the rear_control plugin makes them.
     std::vector<std::string> strategies = rearSteerStrategyNames();
     if (vm.count("strategy")) {
       strategies = splitList(vm["strategy"].as<std::string>());
-      for (const auto& st : strategies) makeRearSteerStrategy(st, linear, &table);  // validates the name
+      std::string known;
+      for (const auto& n : registry.knownChoices("rear_steer_strategy")) known += (known.empty() ? "" : ", ") + n;
+      for (const auto& st : strategies) {
+        if (!registry.hasChoice("rear_steer_strategy", st))
+          throw Error("--strategy: unknown rear steer strategy '" + st + "'; registered: " + known +
+                      (vm.count("plugin") ? "" : " (more from a library: --plugin PATH)"));
+        makeRearSteerStrategy(st, linear, &table, &registry);  // its factory accepts these parameters
+      }
     }
     int threads = vm["threads"].as<int>();
     if (threads < 0) throw Error("--threads must be non-negative, got " + std::to_string(threads));

@@ -4,12 +4,14 @@
 // wheels at zero and at a given ratio of the front angle. Points with no
 // converged steady state are reported as such (no numbers).
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
 
 #include "study.h"
+#include "vdyn/analyses/branch_analyses.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/steady_state/steady_state.h"
@@ -61,16 +63,30 @@ int main(int argc, char** argv) {
     const double ratio = requireFinite(vm["rear-ratio"].as<double>(), "--rear-ratio");
     const std::string out = study::outputDir(vm, "steady_sweep");
 
-    // The composition is the scene (scenes/steady_sweep.json: held front and
-    // rear steering, speed hold), built as `vdyn run` does; speed and angles
-    // change through the plugins' adjustables (continuation, no rebuild).
-    // Each speed gets its own scene, built at that speed (a clean start at
-    // straight running: reusing one scene built at the first speed put 7.5 m/s
-    // and, with the rear at 0.25, 12.5 m/s on another branch, issue 12).
+    // The composition and the analysis are the scene's (scenes/steady_sweep.json:
+    // held front and rear steering, speed hold, continuation in the front angle
+    // with the rear at a ratio of it, the branch check and the stability
+    // verdicts), built as `vdyn run` does for each (ratio, speed) with this
+    // program's grid: ContinuationAnalysis::follow makes the points and
+    // summarize() the per-branch numbers (the same code as `vdyn run`). Each
+    // speed gets its own scene, built at that speed, and its own solver (a clean
+    // start at straight running: reusing one scene built at the first speed put
+    // 7.5 m/s and, with the rear at 0.25, 12.5 m/s on another branch, issue 12).
     const SceneDescription description =
         SceneDescription::fromFile("scenes/steady_sweep.json", standardRegistry(),
                                    {{"vehicle.data", resolveDataPath(vm["data"].as<std::string>())}});
-    const Scene* scp = nullptr;  // the current speed's scene
+    // Every branch starts at straight running (0 deg: the initial state is its
+    // solution) and takes a first small step that stays in the linear range
+    // (neither reported unless asked for).
+    const double firstDeg = std::min(0.01, fronts.front());
+    std::vector<double> frontsRad, lead = {0.0};
+    for (double v : fronts) frontsRad.push_back(v * deg);
+    if (firstDeg < fronts.front()) lead.push_back(firstDeg * deg);
+    auto toDeg = [&](double rad) {  // the grid's own value in deg
+      for (std::size_t i = 0; i < fronts.size(); ++i)
+        if (frontsRad[i] == rad) return fronts[i];
+      return rad == 0 ? 0.0 : rad / deg;
+    };
 
     const std::string csv = out + "/sweep.csv";
     std::ofstream f(csv);
@@ -81,111 +97,64 @@ int main(int argc, char** argv) {
     int points = 0, stable = 0, unstable = 0, none = 0, refused = 0;
     double solveTime = 0, stabilityTime = 0;
     Json byRatio = Json::array(), labels = Json::array();
-    // The branch check (issue 12, item 5): the yaw rate follows the steering's
-    // sign, and from one point to the next it changes like the steering angle
-    // within a factor kJump (r_new/r_prev against delta_new/delta_prev); a
-    // solution outside is another branch, refused, and the step is bisected.
-    const double kJump = 2.0;
-    const double firstDeg = std::min(0.01, fronts.front());  // a first step that stays in the linear range
-    ContinuationOptions copt;
-    copt.max_bisections = 6;
-    copt.accept = [&](const SteadyStateResult* prev, double prevDeg, const SteadyStateResult& next, double fdeg) {
-      const Scene& sc = *scp;
-      const double r = sc.evalOutput("chassis.yaw_rate_rad_s", next.state);
-      if (fdeg == 0) return std::string();
-      if (!(r * fdeg > 0))
-        return "yaw rate " + formatValue(r) + " rad/s against the steering's sign (front " + formatValue(fdeg) + " deg)";
-      if (!prev || prevDeg == 0) return std::string();
-      const double rp = sc.evalOutput("chassis.yaw_rate_rad_s", prev->state);
-      const double q = (r / rp) / (fdeg / prevDeg);
-      if (!(q <= kJump && q >= 1 / kJump))
-        return "yaw rate " + formatValue(r) + " rad/s after " + formatValue(rp) + " rad/s at " + formatValue(prevDeg) +
-               " deg: it changed " + formatValue(q) + " times as much as the steering (bound " + formatValue(kJump) + ")";
-      return std::string();
-    };
+    double kJump = 0;
     std::printf("steady_sweep: %zu speeds x %zu front angles x rear ratios {0, %g}\n", speeds.size(), fronts.size(), ratio);
     std::printf("  %6s %6s  %s\n", "ratio", "U m/s", "largest front angle with a stable steady state (deg); median iterations");
     for (double kr : {0.0, ratio}) {
       Json rows = Json::array();
       for (double U : speeds) {
-        // A fresh solver per speed: nothing of the previous speed's branch
-        // (its last Jacobian, near that branch's end) seeds this one; reusing
-        // it put 7.5 m/s on another branch (issue 12).
         const BuiltScene built = description
                                      .withOverrides({{"vehicle.initial_speed_m_s", U},
-                                                     {"plugins.speed_hold.speed_m_s", U}})
+                                                     {"plugins.speed_hold.speed_m_s", U},
+                                                     {"analysis.also_scales", std::vector<double>{kr}},
+                                                     {"analysis.lead_values", lead},
+                                                     {"analysis.values", frontsRad}})
                                      .build();
         const Scene& sc = built.scene();
-        scp = &sc;
-        const Plugin& front = *sc.findPlugin<Plugin>("front_steer");
-        const Plugin& rear = *sc.findPlugin<Plugin>("rear_steer");
-        const Plugin& hold = *sc.findPlugin<Plugin>("speed_hold");
-        SteadyStateSolver solver(
-            sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
-        SimTK::State start = built.vehicle->makeInitialState(U);
-        hold.setAdjustable(start, "speed_m_s", U);
-        const auto ts = std::chrono::steady_clock::now();
-        // Every speed's branch starts at straight running (0 deg: the initial
-        // state is its solution), takes a first small step, and follows the
-        // front angle up with the branch check above.
-        std::vector<double> values = {0.0, firstDeg};
-        for (double v : fronts)
-          if (v > firstDeg) values.push_back(v);
-        auto pts = followSteadyState(
-            solver, start, values,
-            [&](SimTK::State& st, double fdeg) {
-              front.setAdjustable(st, "angle_rad", fdeg * deg);
-              rear.setAdjustable(st, "angle_rad", kr * fdeg * deg);
-            },
-            copt);
-        if (!pts.front().converged) throw Error("steady_sweep: straight running at " + formatValue(U) + " m/s did not converge: " + pts.front().failure);
-        pts.erase(pts.begin());
-        if (firstDeg < fronts.front() && pts.front().converged) pts.erase(pts.begin());  // not a requested angle
-        solveTime += std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
-        double largestStable = 0;
+        const ContinuationAnalysis& analysis = ContinuationAnalysis::fromScene(built);
+        kJump = analysis.settings().branch_max_change_factor;
+        const BranchRun run = analysis.follow(built);
+        Json branch = analysis.summarize(built, run);
+        assert(run.points.size() == fronts.size());
+        solveTime += run.solve_wall_time_s;
+        stabilityTime += run.stability_wall_time_s;
         std::vector<int> its;
-        int lastStable = -1;  // stability of the previous reported point: -1 none, 0 unstable, 1 stable
-        double lastDeg = 0;
-        for (const auto& p : pts) {
-          ++points;
-          f << kr << ',' << U << ',' << p.value << ',' << kr * p.value << ',';
+        for (std::size_t i = 0; i < run.points.size(); ++i) {
+          const BranchPoint& p = run.points[i];
+          f << kr << ',' << U << ',' << fronts[i] << ',' << kr * fronts[i] << ',' << p.status;
           if (!p.converged) {
-            ++none;
-            const bool jump = p.failure.rfind("branch jump refused", 0) == 0;
-            const bool ended = p.failure.rfind("the branch ended", 0) == 0;
-            refused += jump;
-            f << (jump ? "branch_jump_refused" : ended ? "beyond_branch_end" : "no_steady_state") << ",,,,,,,\n";
-            if (!ended)
-              labels.push_back({{"rear_ratio", kr}, {"speed_m_s", U}, {"from_front_deg", lastDeg},
-                                {"to_front_deg", p.value}, {"label", jump ? "branch_jump_refused" : "branch_end"},
-                                {"reason", p.failure}});
-            lastStable = -1;
+            f << ",,,,,,,\n";
             continue;
           }
-          const auto tst = std::chrono::steady_clock::now();
-          const StabilityResult st = solver.calcStability(p.result);
-          stabilityTime += std::chrono::duration<double>(std::chrono::steady_clock::now() - tst).count();
           const double r = sc.evalOutput("chassis.yaw_rate_rad_s", p.result.state);
-          (st.stable ? stable : unstable)++;
-          if (st.stable) largestStable = std::max(largestStable, p.value);
-          // A change of stability between two points of the branch, located to
-          // the interval between them (a Hopf or fold point lies inside).
-          if (lastStable >= 0 && lastStable != int(st.stable))
-            labels.push_back({{"rear_ratio", kr}, {"speed_m_s", U}, {"from_front_deg", lastDeg},
-                              {"to_front_deg", p.value},
-                              {"label", st.stable ? "unstable_to_stable" : "stable_to_unstable"}});
-          lastStable = int(st.stable);
-          lastDeg = p.value;
           iterations.push_back(p.result.iterations);
           its.push_back(p.result.iterations);
-          f << (st.stable ? "stable" : "unstable") << ',' << U / r << ','
-            << sc.evalOutput("chassis.side_slip_rad", p.result.state) << ',' << r << ',' << U * r << ','
-            << p.result.iterations << ',' << st.least_damped.real() << ',' << st.least_damped.imag() << '\n';
+          f << ',' << U / r << ',' << sc.evalOutput("chassis.side_slip_rad", p.result.state) << ',' << r << ','
+            << U * r << ',' << p.result.iterations << ',' << p.stability.least_damped.real() << ','
+            << p.stability.least_damped.imag() << '\n';
         }
+        for (const Json& l : branch.at("branch_labels")) {
+          Json j = {{"rear_ratio", kr},
+                    {"speed_m_s", U},
+                    {"from_front_deg", toDeg(l.at("from_value").get<double>())},
+                    {"to_front_deg", toDeg(l.at("to_value").get<double>())},
+                    {"label", l.at("label")}};
+          if (l.contains("reason")) j["reason"] = l.at("reason");
+          labels.push_back(j);
+        }
+        points += branch.at("total_points").get<int>();
+        stable += branch.at("stable_points").get<int>();
+        unstable += branch.at("unstable_points").get<int>();
+        none += branch.at("no_steady_state_points").get<int>();
+        refused += branch.at("branch_jumps_refused").get<int>();
+        const double largestStable = toDeg(branch.at("largest_stable_value").get<double>());
         std::sort(its.begin(), its.end());
         std::printf("  %6g %6g  %5.2f; %d\n", kr, U, largestStable, its.empty() ? -1 : its[its.size() / 2]);
         std::fflush(stdout);
-        rows.push_back({{"speed_m_s", U}, {"largest_stable_front_deg", largestStable}});
+        // The branch's numbers as `vdyn run` reports them (the continuation
+        // analysis's summary without the per-point list and the wall times).
+        for (const char* k : {"points", "branch_labels", "solve_wall_time_s", "stability_wall_time_s"}) branch.erase(k);
+        rows.push_back({{"speed_m_s", U}, {"largest_stable_front_deg", largestStable}, {"continuation", branch}});
       }
       byRatio.push_back({{"rear_ratio", kr}, {"speeds", rows}});
     }

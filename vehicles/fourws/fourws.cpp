@@ -1,5 +1,7 @@
 #include "vdyn/vehicles/fourws.h"
 
+#include <algorithm>
+
 #include "vdyn/vehicles/chassis_outputs.h"
 
 #include "vdyn/core/simulation.h"
@@ -165,6 +167,20 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
       con.addAxleSteering(a.name, a.front,
                           std::make_shared<HoldCommand>(a.command ? a.command->calcAt(s.getTime()).angle_rad
                                                                   : a.initial_angle_rad));
+    // Steering plugins a scene file added through the registry (not through
+    // addAxleSteering) are held in the copy the same way, in scene order:
+    // without them the copy's knuckles assembled unsteered and the reduced
+    // vehicle started elsewhere than the same composition in C++.
+    for (const auto& plugin : scene_->getPlugins()) {
+      const auto* sp = dynamic_cast<const SteeringPlugin*>(plugin.get());
+      if (!sp || std::any_of(axleSteering_.begin(), axleSteering_.end(),
+                             [&](const AxleSteering& a) { return a.name == sp->name(); }))
+        continue;
+      const double angle = sp->isStateDriven() ? sp->getSteerBody().getDefaultAngle()
+                                               : sp->command().calcAt(s.getTime()).angle_rad;
+      con.updScene().addPlugin(std::make_unique<SteeringPlugin>(sp->name(), sp->chassisBody(), sp->knuckleBodies(),
+                                                                std::make_shared<HoldCommand>(angle), sp->spinAxis()));
+    }
     const SimTK::State cs = con.makeInitialState(0.0, &conReport);
     chassis_.setQ(s, con.chassis().getQ(cs));
     for (int c = 0; c < 4; ++c) {

@@ -8,6 +8,7 @@
 #include <cmath>
 
 #include "vdyn/analyses/analyses.h"
+#include "vdyn/analyses/branch_analyses.h"
 #include "vdyn/core/equilibrium.h"
 #include "vdyn/steady_state/steady_state.h"
 
@@ -24,12 +25,6 @@ struct SteadySettings {
   int max_iterations = 60;
   bool stability = false;
   double stability_tolerance_per_s = 1e-6;
-  // continuation
-  std::vector<double> values;
-  std::string plugin, key;
-  std::vector<std::string> also_plugins;
-  std::vector<double> also_scales;
-  std::vector<std::string> table_outputs;
 };
 
 template <class T>
@@ -63,23 +58,37 @@ const FieldTable<SteadySettings>& stabilityFields() {
   return t;
 }
 
-const FieldTable<SteadySettings>& continuationFields() {
+using BranchSettings = ContinuationAnalysis::Settings;
+
+const FieldTable<BranchSettings>& continuationFields() {
+  using S = BranchSettings;
   static const auto t = [] {
-    FieldTable<SteadySettings> t;
+    FieldTable<S> t;
     addSteadyFields(t)
-        .string("plugin", &SteadySettings::plugin, "plugin whose adjustable drives the branch", true)
-        .string("key", &SteadySettings::key, "its adjustable: speed_m_s (speed_hold), angle_rad (held steering)", true)
-        .numbers("values", &SteadySettings::values, "(key's)", "values in order along the branch", true)
-        .strings("also_plugins", &SteadySettings::also_plugins, "plugins set to value x also_scales[i] (same key)")
-        .numbers("also_scales", &SteadySettings::also_scales, "", "ratios for also_plugins (e.g. rear/front)")
-        .strings("table_outputs", &SteadySettings::table_outputs, "outputs tabulated per point (default: outputs)")
-        .boolean("stability", &SteadySettings::stability, "stability verdict per converged point");
+        .string("plugin", &S::plugin, "plugin whose adjustable drives the branch", true)
+        .string("key", &S::key, "its adjustable: speed_m_s (speed_hold), angle_rad (held steering)", true)
+        .numbers("values", &S::values, "(key's)", "values in order along the branch", true)
+        .numbers("lead_values", &S::lead_values, "(key's)",
+                 "values solved first to start the branch, not reported (e.g. 0: straight running, then a small "
+                 "first step); the first must converge")
+        .strings("also_plugins", &S::also_plugins, "plugins set to value x also_scales[i] (same key)")
+        .numbers("also_scales", &S::also_scales, "", "ratios for also_plugins (e.g. rear/front)")
+        .strings("table_outputs", &S::table_outputs, "outputs tabulated per point (default: outputs)")
+        .boolean("stability", &S::stability, "stability verdict per converged point")
+        .integer("max_bisections", &S::max_bisections, "", "halvings of a failed (or refused) step before the point fails")
+        .string("branch_output", &S::branch_output,
+                "branch check (none if empty): this output must have the driving value's sign and change from one "
+                "point to the next like the value within branch_max_change_factor; else the solution is another "
+                "branch (refused, the step is bisected)")
+        .number("branch_max_change_factor", &S::branch_max_change_factor, "",
+                "bound of (y_new / y_prev) / (value_new / value_prev) and its inverse");
     return t;
   }();
   return t;
 }
 
-std::vector<std::string> wheelsOf(const SteadySettings& s, const BuiltScene& b) {
+template <class S>
+std::vector<std::string> wheelsOf(const S& s, const BuiltScene& b) {
   if (!s.wheels.empty()) return s.wheels;
   const auto names = b.vehicle->getAttachmentNames();
   if (std::find(names.begin(), names.end(), "wheels") == names.end())
@@ -143,81 +152,6 @@ class SteadyStateAnalysis : public Analysis {
   SteadySettings s_;
 };
 
-class ContinuationAnalysis : public Analysis {
- public:
-  explicit ContinuationAnalysis(const ParamReader& r) : Analysis("continuation") {
-    continuationFields().read(r, s_);
-    if (s_.values.empty()) throw Error(r.at("values") + ": no values");
-    if (s_.also_plugins.size() != s_.also_scales.size())
-      throw Error(r.at("also_scales") + ": one scale per also_plugins entry (" + std::to_string(s_.also_plugins.size()) +
-                  "), got " + std::to_string(s_.also_scales.size()));
-  }
-
- protected:
-  AnalysisResult DoRun(const AnalysisContext& ctx) const override {
-    const Scene& sc = ctx.built.scene();
-    auto find = [&](const std::string& name) -> const Plugin& {
-      for (const auto& p : sc.getPlugins())
-        if (p->name() == name) return *p;
-      throw Error("continuation: the scene has no plugin named '" + name + "'");
-    };
-    const Plugin& driver = find(s_.plugin);
-    std::vector<const Plugin*> also;
-    for (const auto& n : s_.also_plugins) also.push_back(&find(n));
-    SimTK::State start = ctx.built.makeInitialState();
-    SteadyStateOptions opt;
-    opt.force_tolerance = s_.force_tolerance_N;
-    opt.max_iterations = s_.max_iterations;
-    SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, s_.chassis, wheelsOf(s_, ctx.built), s_.time_s), opt);
-    const auto pts = followSteadyState(solver, start, s_.values, [&](SimTK::State& st, double v) {
-      driver.setAdjustable(st, s_.key, v);
-      for (std::size_t i = 0; i < also.size(); ++i) also[i]->setAdjustable(st, s_.key, v * s_.also_scales[i]);
-    });
-    const std::vector<std::string> cols = s_.table_outputs.empty() ? ctx.built.outputs : s_.table_outputs;
-    for (const auto& c : cols) sc.getOutput(c);  // named error if unknown
-    Table t;
-    t.columns = {s_.key, "converged", "iterations"};
-    if (s_.stability) t.columns.insert(t.columns.end(), {"stable", "least_damped_real_per_s", "least_damped_imag_per_s"});
-    t.columns.insert(t.columns.end(), cols.begin(), cols.end());
-    Json points = Json::array();
-    int converged = 0;
-    for (const auto& p : pts) {
-      Json pj = {{"value", p.value}, {"converged", p.converged}};
-      std::vector<double> row = {p.value, p.converged ? 1.0 : 0.0, p.converged ? double(p.result.iterations) : NAN};
-      if (p.converged) {
-        ++converged;
-        pj["iterations"] = p.result.iterations;
-        if (s_.stability) {
-          const StabilityResult st = solver.calcStability(p.result);
-          pj["stable"] = st.stable;
-          pj["least_damped_eigenvalue"] = {st.least_damped.real(), st.least_damped.imag()};
-          row.insert(row.end(), {st.stable ? 1.0 : 0.0, st.least_damped.real(), st.least_damped.imag()});
-        }
-        Json outs = Json::object();
-        for (const auto& c : cols) {
-          const double v = sc.evalOutput(c, p.result.state);
-          outs[c] = v;
-          row.push_back(v);
-        }
-        pj["outputs"] = outs;
-      } else {
-        pj["failure"] = p.failure;
-        if (s_.stability) row.insert(row.end(), {NAN, NAN, NAN});
-        row.insert(row.end(), cols.size(), NAN);  // no numbers for a point without a steady state
-      }
-      points.push_back(pj);
-      t.rows.push_back(row);
-    }
-    AnalysisResult res;
-    res.summary = {{"points", points}, {"converged_points", converged}, {"total_points", pts.size()}};
-    res.tables.push_back({"continuation", t});
-    return res;
-  }
-
- private:
-  SteadySettings s_;
-};
-
 struct EquilibriumSettings {
   std::vector<std::string> ineffective_bodies;
   double force_tolerance_N = 1e-6;
@@ -266,6 +200,195 @@ class StaticEquilibriumAnalysis : public Analysis {
 };
 
 }  // namespace
+
+ContinuationAnalysis::ContinuationAnalysis(const ParamReader& r) : Analysis("continuation") {
+  continuationFields().read(r, s_);
+  if (s_.values.empty()) throw Error(r.at("values") + ": no values");
+  if (s_.also_plugins.size() != s_.also_scales.size())
+    throw Error(r.at("also_scales") + ": one scale per also_plugins entry (" + std::to_string(s_.also_plugins.size()) +
+                "), got " + std::to_string(s_.also_scales.size()));
+  requirePositive(s_.force_tolerance_N, r.at("force_tolerance_N"));
+  if (s_.max_iterations < 1) throw Error(r.at("max_iterations") + ": must be >= 1, got " + std::to_string(s_.max_iterations));
+  if (s_.max_bisections < 0) throw Error(r.at("max_bisections") + ": must be >= 0, got " + std::to_string(s_.max_bisections));
+  if (!(s_.branch_max_change_factor > 1))
+    throw Error(r.at("branch_max_change_factor") + ": must be > 1, got " + formatValue(s_.branch_max_change_factor));
+}
+
+const ContinuationAnalysis& ContinuationAnalysis::fromScene(const BuiltScene& built) {
+  const auto* a = dynamic_cast<const ContinuationAnalysis*>(built.analysis.get());
+  if (!a)
+    throw Error("scene '" + built.name + "': its analysis is " +
+                (built.analysis ? "'" + built.analysis->type() + "'" : std::string("none")) + ", not continuation");
+  return *a;
+}
+
+BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
+  const Scene& sc = built.scene();
+  auto find = [&](const std::string& name) -> const Plugin& {
+    for (const auto& p : sc.getPlugins())
+      if (p->name() == name) return *p;
+    throw Error("continuation: the scene has no plugin named '" + name + "'");
+  };
+  const Plugin& driver = find(s_.plugin);
+  std::vector<const Plugin*> also;
+  for (const auto& n : s_.also_plugins) also.push_back(&find(n));
+  SimTK::State start = built.makeInitialState();
+  SteadyStateOptions opt;
+  opt.force_tolerance = s_.force_tolerance_N;
+  opt.max_iterations = s_.max_iterations;
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, s_.chassis, wheelsOf(s_, built), s_.time_s), opt);
+  ContinuationOptions copt;
+  copt.max_bisections = s_.max_bisections;
+  if (!s_.branch_output.empty()) {
+    sc.getOutput(s_.branch_output);  // named error if unknown
+    const std::string y = s_.branch_output;
+    const double k = s_.branch_max_change_factor;
+    copt.accept = [&sc, y, k](const SteadyStateResult* prev, double prevValue, const SteadyStateResult& next,
+                              double value) {
+      const double r = sc.evalOutput(y, next.state);
+      if (value == 0) return std::string();
+      if (!(r * value > 0))
+        return y + " = " + formatValue(r) + " against the driving value's sign (" + formatValue(value) + ")";
+      if (!prev || prevValue == 0) return std::string();
+      const double rp = sc.evalOutput(y, prev->state);
+      const double q = (r / rp) / (value / prevValue);
+      if (!(q <= k && q >= 1 / k))
+        return y + " = " + formatValue(r) + " after " + formatValue(rp) + " at " + formatValue(prevValue) +
+               ": it changed " + formatValue(q) + " times as much as the driving value (bound " + formatValue(k) + ")";
+      return std::string();
+    };
+  }
+  std::vector<double> values = s_.lead_values;
+  values.insert(values.end(), s_.values.begin(), s_.values.end());
+  BranchRun run;
+  const auto t0 = std::chrono::steady_clock::now();
+  auto pts = followSteadyState(
+      solver, start, values,
+      [&](SimTK::State& st, double v) {
+        driver.setAdjustable(st, s_.key, v);
+        for (std::size_t i = 0; i < also.size(); ++i) also[i]->setAdjustable(st, s_.key, v * s_.also_scales[i]);
+      },
+      copt);
+  run.solve_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  if (!s_.lead_values.empty() && !pts.front().converged)
+    throw Error("continuation: no steady state at the first lead value " + formatValue(s_.lead_values.front()) +
+                " (" + s_.key + " of '" + s_.plugin + "'): " + pts.front().failure);
+  pts.erase(pts.begin(), pts.begin() + s_.lead_values.size());
+  for (auto& p : pts) {
+    BranchPoint b;
+    b.value = p.value;
+    b.converged = p.converged;
+    b.failure = p.failure;
+    if (!p.converged) {
+      b.status = p.failure.rfind("branch jump refused", 0) == 0 ? "branch_jump_refused"
+                 : p.failure.rfind("the branch ended", 0) == 0  ? "beyond_branch_end"
+                                                                 : "no_steady_state";
+    } else if (s_.stability) {
+      const auto ts = std::chrono::steady_clock::now();
+      b.stability = solver.calcStability(p.result);
+      run.stability_wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();
+      b.stability_checked = true;
+      b.status = b.stability.stable ? "stable" : "unstable";
+    } else {
+      b.status = "converged";
+    }
+    b.result = std::move(p.result);
+    run.points.push_back(std::move(b));
+  }
+  return run;
+}
+
+Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& run) const {
+  const Scene& sc = built.scene();
+  const std::vector<std::string> cols = s_.table_outputs.empty() ? built.outputs : s_.table_outputs;
+  Json points = Json::array(), labels = Json::array(), last;
+  int converged = 0, stable = 0, unstable = 0, none = 0, refused = 0;
+  std::vector<int> its;
+  double largestStable = 0, lastValue = 0;
+  int lastStable = -1;  // stability of the previous reported point: -1 none, 0 unstable, 1 stable
+  for (const auto& p : run.points) {
+    Json pj = {{"value", p.value}, {"converged", p.converged}, {"status", p.status}};
+    if (!p.converged) {
+      ++none;
+      refused += p.status == "branch_jump_refused";
+      pj["failure"] = p.failure;
+      if (p.status != "beyond_branch_end")
+        labels.push_back({{"from_value", lastValue},
+                          {"to_value", p.value},
+                          {"label", p.status == "branch_jump_refused" ? "branch_jump_refused" : "branch_end"},
+                          {"reason", p.failure}});
+      lastStable = -1;
+      points.push_back(pj);
+      continue;
+    }
+    ++converged;
+    its.push_back(p.result.iterations);
+    pj["iterations"] = p.result.iterations;
+    if (p.stability_checked) {
+      const bool st = p.stability.stable;
+      (st ? stable : unstable)++;
+      if (st) largestStable = std::max(largestStable, p.value);
+      // A change of stability between two points of the branch, located to
+      // the interval between them (a Hopf or fold point lies inside).
+      if (lastStable >= 0 && lastStable != int(st))
+        labels.push_back({{"from_value", lastValue},
+                          {"to_value", p.value},
+                          {"label", st ? "unstable_to_stable" : "stable_to_unstable"}});
+      lastStable = int(st);
+      pj["stable"] = st;
+      pj["least_damped_eigenvalue"] = {p.stability.least_damped.real(), p.stability.least_damped.imag()};
+    }
+    lastValue = p.value;
+    Json outs = Json::object();
+    for (const auto& c : cols) outs[c] = sc.evalOutput(c, p.result.state);
+    pj["outputs"] = outs;
+    last = {{"value", p.value}, {"iterations", p.result.iterations}, {"outputs", outs}};
+    points.push_back(pj);
+  }
+  std::vector<int> sorted = its;
+  std::sort(sorted.begin(), sorted.end());
+  Json j = {{"points", points},
+            {"total_points", run.points.size()},
+            {"converged_points", converged},
+            {"no_steady_state_points", none},
+            {"branch_jumps_refused", refused},
+            {"median_iterations_per_point", sorted.empty() ? -1 : sorted[sorted.size() / 2]},
+            {"max_iterations_per_point", sorted.empty() ? -1 : sorted.back()},
+            {"branch_labels", labels},
+            {"solve_wall_time_s", run.solve_wall_time_s}};
+  if (s_.stability)
+    j.update({{"stable_points", stable},
+              {"unstable_points", unstable},
+              {"largest_stable_value", largestStable},
+              {"stability_wall_time_s", run.stability_wall_time_s}});
+  if (!last.is_null()) j["last_converged_point"] = last;
+  return j;
+}
+
+AnalysisResult ContinuationAnalysis::DoRun(const AnalysisContext& ctx) const {
+  const BranchRun run = follow(ctx.built);
+  const Scene& sc = ctx.built.scene();
+  const std::vector<std::string> cols = s_.table_outputs.empty() ? ctx.built.outputs : s_.table_outputs;
+  for (const auto& c : cols) sc.getOutput(c);  // named error if unknown
+  Table t;
+  t.columns = {s_.key, "converged", "iterations"};
+  if (s_.stability) t.columns.insert(t.columns.end(), {"stable", "least_damped_real_per_s", "least_damped_imag_per_s"});
+  t.columns.insert(t.columns.end(), cols.begin(), cols.end());
+  for (const auto& p : run.points) {
+    std::vector<double> row = {p.value, p.converged ? 1.0 : 0.0, p.converged ? double(p.result.iterations) : NAN};
+    if (s_.stability && p.stability_checked)
+      row.insert(row.end(), {p.stability.stable ? 1.0 : 0.0, p.stability.least_damped.real(),
+                             p.stability.least_damped.imag()});
+    else if (s_.stability)
+      row.insert(row.end(), {NAN, NAN, NAN});
+    for (const auto& c : cols) row.push_back(p.converged ? sc.evalOutput(c, p.result.state) : NAN);  // no numbers without a steady state
+    t.rows.push_back(row);
+  }
+  AnalysisResult res;
+  res.summary = summarize(ctx.built, run);
+  res.tables.push_back({"continuation", t});
+  return res;
+}
 
 void registerSteadyAnalyses(PluginRegistry& registry) {
   registry.addAnalysis(
