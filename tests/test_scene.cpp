@@ -391,3 +391,33 @@ TEST(SceneFile, ReducedFourWsStartsLikeTheCxxCompositionWithItsSteeringHolds) {
   for (int c : {RF, LF}) EXPECT_NEAR(car.reducedCorner(c).knuckle.getOneQ(cs, 1), 0.05, 1e-9);
   for (int c : {RR, LR}) EXPECT_NEAR(car.reducedCorner(c).knuckle.getOneQ(cs, 1), 0.02, 1e-9);
 }
+
+// The continuation's lead values start the branch and are not reported: the
+// points after them are the same solves as in a run that reports them (bit for
+// bit); the branch check's output must exist and its bound exceed 1.
+TEST(SceneAnalyses, ContinuationLeadValuesAreSolvedButNotReported) {
+  // scenes/steady_sweep.json: 10 m/s, rear at 0.25 of the front, branch check on the yaw rate.
+  const SceneDescription sweep = SceneDescription::fromFile("scenes/steady_sweep.json", standardRegistry());
+  const Json all = runScene(sweep.withOverrides({{"analysis.lead_values", Json::array()},
+                                                 {"analysis.values", {0.0, 1e-4, 0.01, 0.02}}}));
+  const Json led = runScene(sweep.withOverrides({{"analysis.lead_values", {0.0, 1e-4}},
+                                                 {"analysis.values", {0.01, 0.02}}}));
+  ASSERT_EQ(all["total_points"].get<int>(), 4);
+  ASSERT_EQ(all["converged_points"].get<int>(), 4);
+  ASSERT_EQ(led["total_points"].get<int>(), 2);
+  for (int i = 0; i < 2; ++i) {
+    EXPECT_EQ(led["points"][i]["value"], all["points"][i + 2]["value"]);
+    EXPECT_EQ(led["points"][i]["outputs"]["chassis.yaw_rate_rad_s"].get<double>(),
+              all["points"][i + 2]["outputs"]["chassis.yaw_rate_rad_s"].get<double>());
+    EXPECT_EQ(led["points"][i]["iterations"], all["points"][i + 2]["iterations"]);
+  }
+  EXPECT_EQ(led["stable_points"].get<int>(), 2);  // 10 m/s, 0.6 and 1.1 deg: stable
+  EXPECT_EQ(led["largest_stable_value"].get<double>(), 0.02);
+  EXPECT_EQ(led["last_converged_point"]["value"].get<double>(), 0.02);
+  EXPECT_GT(led["last_converged_point"]["outputs"]["chassis.yaw_rate_rad_s"].get<double>(), 0.0);  // turning left
+
+  EXPECT_TRUE(contains(errorOf([&] { sweep.withOverride("analysis.branch_max_change_factor", 1.0).build(); }),
+                       "analysis.branch_max_change_factor: must be > 1, got 1"));
+  EXPECT_TRUE(contains(errorOf([&] { runScene(sweep.withOverride("analysis.branch_output", "chassis.yaw_rat")); }),
+                       "chassis.yaw_rat"));
+}
