@@ -113,7 +113,12 @@ int main(int argc, char** argv) {
         const Scene& sc = built.scene();
         const ContinuationAnalysis& analysis = ContinuationAnalysis::fromScene(built);
         kJump = analysis.settings().branch_max_change_factor;
-        const BranchRun run = analysis.follow(built);
+        BranchRun run;
+        try {
+          run = analysis.follow(built);
+        } catch (const std::exception& e) {
+          throw Error("steady_sweep: at " + formatValue(U) + " m/s, rear ratio " + formatValue(kr) + ": " + e.what());
+        }
         Json branch = analysis.summarize(built, run);
         assert(run.points.size() == fronts.size());
         solveTime += run.solve_wall_time_s;
