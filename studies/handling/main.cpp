@@ -24,6 +24,14 @@ using namespace vdyn;
 namespace {
 const double kDeg = SimTK::Pi / 180;
 
+/// `digits` significant digits (%g), "-" for a missing (non-finite) value.
+std::string formatSig(double v, int digits = 4) {
+  if (!std::isfinite(v)) return "-";
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
+}
+
 struct Config {
   ParamReader data;
   FourWsParams fourws;
@@ -234,37 +242,60 @@ Json sineWithDwell(const Config& c, const std::string& vehicle, const std::strin
   const std::string t = fileTag(vehicle);
   Json runs = Json::array();
   std::vector<study::Series> ser;
-  double worst1 = 0, worst175 = 0, minDisp = 1e300;
-  int failedRuns = 0;
+  // Ratios and displacement over the completed runs only; a spun-out or failed
+  // run has no number: it is counted, and the first one named.
+  double worst1 = -1e300, worst175 = -1e300, minDisp = 1e300;
+  int spun = 0, failed = 0, completedFrom5 = 0;
+  std::string firstFail;  // the smallest amplitude that fails, and why
   for (const auto& run : r.runs) {
     Json jr = {{"factor", run.factor}, {"amplitude_deg", run.amplitude_rad / kDeg}, {"completed", run.completed},
-               {"pass", run.pass}};
+               {"spun_out", run.spun_out}, {"pass", run.pass}};
     if (run.completed) {
       const std::string csv = out + "/swd_" + t + "_" + formatValue(run.factor) + "A.csv";
       run.history.writeCsv(csv);
       ser.push_back({csv, "t_s", "yaw_rate_rad_s", formatValue(run.factor) + " A"});
       jr["peak_yaw_rate_rad_s"] = run.peak_yaw_rate_rad_s;
+      jr["peak_time_s"] = run.peak_time_s;
       jr["yaw_ratio_1s"] = run.yaw_ratio_1s;
       jr["yaw_ratio_1_75s"] = run.yaw_ratio_175;
       jr["lateral_displacement_m"] = run.lateral_displacement_m;
       worst1 = std::max(worst1, run.yaw_ratio_1s);
       worst175 = std::max(worst175, run.yaw_ratio_175);
-      if (run.factor >= set.displacement_from_factor - 1e-9) minDisp = std::min(minDisp, run.lateral_displacement_m);
+      if (run.factor >= set.displacement_from_factor - 1e-9) {
+        minDisp = std::min(minDisp, run.lateral_displacement_m);
+        ++completedFrom5;
+      }
     } else {
       jr["reason"] = run.reason;
-      ++failedRuns;
+      ++(run.spun_out ? spun : failed);
     }
+    if (!run.pass && firstFail.empty())
+      firstFail = (run.spun_out ? "spin" : !run.completed ? "failed" : run.yaw_ratio_1s > set.yaw_ratio_1s_limit ? "r1.0"
+                   : run.yaw_ratio_175 > set.yaw_ratio_175_limit ? "r1.75" : "disp") + std::string(" ") +
+                  formatValue(run.factor) + "A";
     runs.push_back(jr);
   }
-  std::printf("  SWD      %-14s A %.3f deg, %zu runs (%d spun/failed): max ratio 1.0 s %.3f, 1.75 s %.3f, min "
-              "displacement (>= 5A) %.3f m -> %s\n",
-              vehicle.c_str(), r.angle_A_rad / kDeg, r.runs.size(), failedRuns, worst1, worst175,
-              minDisp < 1e300 ? minDisp : std::nan(""), r.pass ? "PASS" : "FAIL");
+  const int completed = int(r.runs.size()) - spun - failed;
+  std::printf("  SWD      %-14s A %.3f deg, %zu runs: %d completed, %d spun out, %d failed; completed runs: max ratio "
+              "1.0 s %s, 1.75 s %s; displacement from %g A %s -> %s%s\n",
+              vehicle.c_str(), r.angle_A_rad / kDeg, r.runs.size(), completed, spun, failed,
+              completed ? formatSig(worst1, 3).c_str() : "-", completed ? formatSig(worst175, 3).c_str() : "-",
+              set.displacement_from_factor,
+              completedFrom5 ? ("min " + formatSig(minDisp, 3) + " m").c_str() : "(no run completed)",
+              r.pass ? "PASS" : "FAIL", firstFail.empty() ? "" : (" (first: " + firstFail + ")").c_str());
   if (plots && !ser.empty())
     study::plot({{out + "/swd_" + t + ".png", "sine with dwell " + vehicle, "t (s)", "yaw rate (rad/s)", ser}});
-  return {{"angle_A_deg", r.angle_A_rad / kDeg}, {"runs", runs}, {"pass", r.pass},
-          {"max_yaw_ratio_1s", worst1},      {"max_yaw_ratio_1_75s", worst175},
-          {"min_lateral_displacement_m", minDisp < 1e300 ? Json(minDisp) : Json(nullptr)}, {"failed_runs", failedRuns}};
+  auto orNull = [](bool have, double x) { return have ? Json(x) : Json(nullptr); };
+  return {{"angle_A_deg", r.angle_A_rad / kDeg},
+          {"runs", runs},
+          {"pass", r.pass},
+          {"completed_runs", completed},
+          {"spun_out_runs", spun},
+          {"failed_runs", failed},
+          {"first_fail", firstFail.empty() ? Json(nullptr) : Json(firstFail)},
+          {"max_yaw_ratio_1s", orNull(completed > 0, worst1)},
+          {"max_yaw_ratio_1_75s", orNull(completed > 0, worst175)},
+          {"min_lateral_displacement_m", orNull(completedFrom5 > 0, minDisp)}};
 }
 Json iso3888(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
   const ParamReader p = c.data.child("iso3888");

@@ -170,12 +170,15 @@ class SineWithDwellAnalysis : public Analysis {
     const SineWithDwellResult r = runSineWithDwell(b->vehicle, s_);
     AnalysisResult res;
     Table t;
-    t.columns = {"factor", "amplitude_deg", "completed", "yaw_ratio_1s", "yaw_ratio_1_75s", "lateral_displacement_m", "pass"};
+    // A spun-out or failed run has no ratios (NaN cells, the reason in the summary).
+    t.columns = {"factor", "amplitude_deg", "completed", "spun_out", "peak_yaw_rate_rad_s", "yaw_ratio_1s",
+                 "yaw_ratio_1_75s", "lateral_displacement_m", "pass"};
     Json runs = Json::array();
     for (const auto& q : r.runs) {
-      t.rows.push_back({q.factor, q.amplitude_rad / kDeg, double(q.completed), q.completed ? q.yaw_ratio_1s : NAN,
+      t.rows.push_back({q.factor, q.amplitude_rad / kDeg, double(q.completed), double(q.spun_out),
+                        q.completed ? q.peak_yaw_rate_rad_s : NAN, q.completed ? q.yaw_ratio_1s : NAN,
                         q.completed ? q.yaw_ratio_175 : NAN, q.completed ? q.lateral_displacement_m : NAN, double(q.pass)});
-      Json j = {{"factor", q.factor}, {"completed", q.completed}, {"pass", q.pass}};
+      Json j = {{"factor", q.factor}, {"completed", q.completed}, {"spun_out", q.spun_out}, {"pass", q.pass}};
       if (!q.completed) j["reason"] = q.reason;
       runs.push_back(j);
     }
