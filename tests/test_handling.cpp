@@ -346,6 +346,24 @@ TEST(SineWithDwell, ASpinningVehicleIsReportedAsSpunOutWithoutRatios) {
   EXPECT_FALSE(b.completed);
   EXPECT_TRUE(b.spun_out);
   EXPECT_NE(b.reason.find("exceeds its peak"), std::string::npos) << b.reason;
+  // A slow spin: the peak at 1.8 s, a decay to 80 % of it by 3.5 s, then the
+  // yaw rate grows again to 92 % at the end (5 s): spun out, although it never
+  // passes the peak within the run.
+  const HandlingHistory slowSpin = syntheticHistory(
+      5.0,
+      [&](double t) {
+        if (t < tm.bos_s) return 0.0;
+        if (t < tm.reversal_s) return lobe(t);
+        if (t < 1.8) return -0.4 * std::sin(0.5 * SimTK::Pi * (t - tm.reversal_s) / 0.6);
+        if (t < 3.5) return -0.4 * (1 - 0.2 * (t - 1.8) / 1.7);
+        return -0.4 * (0.8 + 0.08 * (t - 3.5));
+      },
+      y);
+  SineWithDwellRun d;
+  evaluateSineWithDwellRun(slowSpin, tm, set, d);
+  EXPECT_FALSE(d.completed);
+  EXPECT_TRUE(d.spun_out);
+  EXPECT_NE(d.reason.find("grows again"), std::string::npos) << d.reason;
   // The first lobe's yaw rate retreating at the reversal is not the peak: a
   // yaw rate that is still negative from the first lobe, rises to -0.1, then
   // falls to its real peak -0.3 at 2.0 s and decays.

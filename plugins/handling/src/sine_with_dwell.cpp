@@ -72,13 +72,13 @@ void evaluateSineWithDwellRun(const HandlingHistory& h, const SineWithDwellTimes
   if (!found) {
     run.spun_out = true;
     run.reason = "spun out: the yaw rate after the steering reversal has no peak up to COS + 1.0 s (" +
-                 formatValue(interpolate(t, r, tSample1)) + " rad/s there, still growing)";
+                 formatSig(interpolate(t, r, tSample1)) + " rad/s there, still growing)";
     return;
   }
   const double pk = r[im];
   if (!(sg * pk > 0)) {
     run.reason = "the yaw rate did not take the reversal's sign (its first peak after the reversal is " +
-                 formatValue(pk) + " rad/s)";
+                 formatSig(pk) + " rad/s)";
     return;
   }
   // With the steering centred (from COS) a recovering vehicle's yaw rate
@@ -87,11 +87,22 @@ void evaluateSineWithDwellRun(const HandlingHistory& h, const SineWithDwellTimes
   for (std::size_t k = im + 1; k < t.size(); ++k)
     if (t[k] >= tm.cos_s && std::abs(r[k]) > std::abs(pk)) {
       run.spun_out = true;
-      run.reason = "spun out: the yaw rate " + formatValue(r[k]) + " rad/s at t = " + formatValue(t[k]) +
-                   " s exceeds its peak after the steering reversal (" + formatValue(pk) + " rad/s at " +
-                   formatValue(t[im]) + " s)";
+      run.reason = "spun out: the yaw rate " + formatSig(r[k]) + " rad/s at t = " + formatSig(t[k]) +
+                   " s exceeds its peak after the steering reversal (" + formatSig(pk) + " rad/s at " +
+                   formatSig(t[im]) + " s)";
       return;
     }
+  // Nor does it turn back into the spin: a yaw rate that grows again after the
+  // second ratio sample and ends above half the peak (a slow spin that has not
+  // passed the peak before the run ends).
+  const double rS = interpolate(t, r, tSample175), rE = r.back();
+  if (t.back() > tSample175 && sg * rE > sg * rS && sg * rE > 0.5 * std::abs(pk)) {
+    run.spun_out = true;
+    run.reason = "spun out: with the steering centred the yaw rate grows again, from " + formatSig(rS) +
+                 " rad/s at COS + 1.75 s to " + formatSig(rE) + " rad/s at " + formatSig(t.back()) + " s (peak " +
+                 formatSig(pk) + " rad/s)";
+    return;
+  }
   run.completed = true;
   run.peak_yaw_rate_rad_s = pk;
   run.peak_time_s = t[im];

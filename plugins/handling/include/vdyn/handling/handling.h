@@ -132,6 +132,10 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double speed_m_s,
                                      RunSummary* summary = nullptr, const std::vector<double>& restarts_s = {},
                                      double coast_from_s = 1e300, const SimTK::State* start = nullptr);
 
+/// `digits` significant digits (printf %g) for reports and run messages
+/// (formatValue's round-trip 17 digits are for echoing user input).
+std::string formatSig(double v, int digits = 4);
+
 /// Linear interpolation of y(t) at t (clamped).
 double interpolate(const std::vector<double>& t, const std::vector<double>& y, double at);
 

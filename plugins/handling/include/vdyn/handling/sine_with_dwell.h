@@ -57,7 +57,8 @@ struct SineWithDwellRun {
   bool completed = false;
   /// The vehicle did not recover: its side slip passed the spin limit, or the
   /// yaw rate after the steering reversal had no peak before COS + 1.0 s, or
-  /// with the steering centred (after COS) it grew beyond that peak.
+  /// with the steering centred (after COS) it grew beyond that peak, or grew
+  /// again after COS + 1.75 s to end the run above half the peak.
   bool spun_out = false;
   std::string reason;
   /// First local peak of the yaw rate after the steering changes sign (the
@@ -87,7 +88,8 @@ struct SineWithDwellTimes {
 /// from zero, then back by more than 1 % of the peak), the ratios at COS +
 /// 1.0 / 1.75 s and the displacement; sets completed = false and spun_out =
 /// true (no number) when there is no such peak before COS + 1.0 s or the yaw
-/// rate exceeds it in magnitude after COS, and completed = false when the yaw rate
+/// rate exceeds it in magnitude after COS or grows again after COS + 1.75 s
+/// to end above half of it, and completed = false when the yaw rate
 /// never takes the reversal's sign. pass against the settings' limits.
 /// The history must cover COS + 1.75 s.
 void evaluateSineWithDwellRun(const HandlingHistory& history, const SineWithDwellTimes& times,
