@@ -18,21 +18,29 @@ void SineWithDwellSettings::validate() const {
   requirePositive(sample_s, "sine with dwell sample_s");
 }
 
+const FieldTable<SineWithDwellSettings>& SineWithDwellSettings::fields() {
+  using S = SineWithDwellSettings;
+  static const FieldTable<S> t = [] {
+    FieldTable<S> f;
+    addTransientTestKeys(f, "entry speed (80 km/h; held up to the beginning of steer)",
+                         "steady lateral acceleration defining A (0.3 g)")
+        .number("frequency_Hz", &S::frequency_Hz, "Hz", "sine frequency")
+        .number("dwell_s", &S::dwell_s, "s", "dwell at the second peak")
+        .number("start_s", &S::start_s, "s", "beginning of steer (BOS)")
+        .number("after_s", &S::after_s, "s", "simulated time after the completion of steer (>= 1.75)")
+        .number("first_factor", &S::first_factor, "", "first amplitude / A")
+        .number("factor_step", &S::factor_step, "", "amplitude increment / A")
+        .number("max_amplitude_factor", &S::max_amplitude_factor, "", "last amplitude / A")
+        .number("max_amplitude_rad", &S::max_amplitude_rad, "rad", "cap on the road-wheel amplitude")
+        .boolean("coast", &S::coast, "coast from the beginning of steer (false: speed held)");
+    return f;
+  }();
+  return t;
+}
+
 SineWithDwellSettings SineWithDwellSettings::fromParams(const ParamReader& r) {
   SineWithDwellSettings s;
-  s.speed_m_s = r.numberOr("speed_m_s", s.speed_m_s);
-  s.lateral_accel_m_s2 = r.numberOr("lateral_accel_m_s2", s.lateral_accel_m_s2);
-  s.frequency_Hz = r.numberOr("frequency_Hz", s.frequency_Hz);
-  s.dwell_s = r.numberOr("dwell_s", s.dwell_s);
-  s.start_s = r.numberOr("start_s", s.start_s);
-  s.after_s = r.numberOr("after_s", s.after_s);
-  s.first_factor = r.numberOr("first_factor", s.first_factor);
-  s.factor_step = r.numberOr("factor_step", s.factor_step);
-  s.max_amplitude_factor = r.numberOr("max_amplitude_factor", s.max_amplitude_factor);
-  s.max_amplitude_rad = r.numberOr("max_amplitude_rad", s.max_amplitude_rad);
-  s.sample_s = r.numberOr("sample_s", s.sample_s);
-  s.coast = r.booleanOr("coast", s.coast);
-  if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+  fields().read(r, s);
   s.validate();
   return s;
 }

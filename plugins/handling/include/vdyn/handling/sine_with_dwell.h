@@ -25,8 +25,11 @@ namespace vdyn {
 struct SineWithDwellSettings {
   /// Keys as the fields (speed_m_s, lateral_accel_m_s2, frequency_Hz, dwell_s,
   /// start_s, after_s, first_factor, factor_step, max_amplitude_factor,
-  /// max_amplitude_rad, sample_s, coast, integrator), each optional.
+  /// max_amplitude_rad, sample_s, coast, integrator), each optional:
+  /// fields(), then validate().
   static SineWithDwellSettings fromParams(const ParamReader& r);
+  /// The key table (reading, `vdyn list`).
+  static const FieldTable<SineWithDwellSettings>& fields();
 
   double speed_m_s = 80.0 / 3.6;      ///< m/s (80 km/h)
   double lateral_accel_m_s2 = 0.3 * 9.81;  ///< a_y defining A, m/s^2 (0.3 g)
