@@ -42,8 +42,43 @@ std::unique_ptr<FourWsVehicle> ch3Car(const std::string& model, const std::strin
   return car;
 }
 
+/// The two corner models compared throughout.
+const char* const kModels[2] = {"constrained", "reduced"};
+
 double vee(const SimTK::Mat33& W, int i) {
   return i == 0 ? 0.5 * (W(2, 1) - W(1, 2)) : i == 1 ? 0.5 * (W(0, 2) - W(2, 0)) : 0.5 * (W(1, 0) - W(0, 1));
+}
+
+/// The integrator of the ch3 comparisons: accuracy 1e-8, constraint tolerance 1e-10, to t_end_s.
+SimulationSettings ch3Simulation(double t_end_s) {
+  SimulationSettings sim;
+  sim.t_end_s = t_end_s;
+  sim.integrator.accuracy = 1e-8;
+  sim.integrator.constraint_tolerance = 1e-10;
+  return sim;
+}
+
+/// Runs `sa` in scene `a` and `sb` in scene `b` for 2.5 s of the ch3 manoeuvre
+/// (sampled every 0.05 s) and expects the same yaw rate, roll and front
+/// steering angle histories: max difference < 1e-6 x the first run's peak,
+/// each peak > 1e-3 (the vehicle is turning: the comparison is not trivial).
+void expectSameCh3Transient(const Scene& a, SimTK::State& sa, const Scene& b, SimTK::State& sb) {
+  SimulationSettings sim = ch3Simulation(2.5);
+  sim.report_interval_s = 0.05;
+  const std::vector<std::string> cols = {"chassis.yaw_rate_rad_s", "chassis.roll_rad", "front_steer.angle_rad"};
+  Recorder ra(a, cols), rb(b, cols);
+  simulate(a, sa, sim, &ra);
+  simulate(b, sb, sim, &rb);
+  ASSERT_EQ(ra.size(), rb.size());
+  for (const auto& n : cols) {
+    double scale = 0, err = 0;
+    for (std::size_t i = 0; i < ra.size(); ++i) {
+      scale = std::max(scale, std::abs(ra.column(n)[i]));
+      err = std::max(err, std::abs(ra.column(n)[i] - rb.column(n)[i]));
+    }
+    EXPECT_GT(scale, 1e-3) << n;
+    EXPECT_LT(err / scale, 1e-6) << n;
+  }
 }
 }  // namespace
 
@@ -138,17 +173,20 @@ TEST(ReducedCorner, VelocitiesAndAccelerationsMatchFiniteDifferencesOfPositions)
   const ReducedWishboneCorner& rc = car.reducedCorner(LF);
   SimTK::State s = car.makeInitialState();
   const double q0 = 0.03, q1 = 0.2, u0 = 0.7, u1 = -1.3;
-  auto at = [&](double t) {
-    // q(t) = q + u t (constant rates): knuckle pose in ground.
-    SimTK::State x = s;
+  // The motion q(t) = q + u t (constant rates) at time t.
+  auto setMotion = [&](SimTK::State& x, double t) {
     setReducedCornerPosition(x, rc, q0 + u0 * t, q1 + u1 * t);
+    rc.knuckle.setOneU(x, 0, u0);
+    rc.knuckle.setOneU(x, 1, u1);
+    rc.lower_arm.setOneU(x, 0, u0);
+  };
+  auto at = [&](double t) {  // knuckle pose in ground
+    SimTK::State x = s;
+    setMotion(x, t);
     sys.realize(x, SimTK::Stage::Position);
     return rc.knuckle.getBodyTransform(x);
   };
-  setReducedCornerPosition(s, rc, q0, q1);
-  rc.knuckle.setOneU(s, 0, u0);
-  rc.knuckle.setOneU(s, 1, u1);
-  rc.lower_arm.setOneU(s, 0, u0);
+  setMotion(s, 0);
   sys.realize(s, SimTK::Stage::Velocity);
   const double h = 1e-4;
   const SimTK::Transform Xp = at(h), Xm = at(-h), X0 = at(0);
@@ -168,10 +206,7 @@ TEST(ReducedCorner, VelocitiesAndAccelerationsMatchFiniteDifferencesOfPositions)
   // Angular: dw/dt from a difference of the angular velocities at t +- h.
   auto omega = [&](double t) {
     SimTK::State x = s;
-    setReducedCornerPosition(x, rc, q0 + u0 * t, q1 + u1 * t);
-    rc.knuckle.setOneU(x, 0, u0);
-    rc.knuckle.setOneU(x, 1, u1);
-    rc.lower_arm.setOneU(x, 0, u0);
+    setMotion(x, t);
     sys.realize(x, SimTK::Stage::Velocity);
     return rc.knuckle.getBodyAngularVelocity(x);
   };
@@ -182,9 +217,8 @@ TEST(ReducedCorner, VelocitiesAndAccelerationsMatchFiniteDifferencesOfPositions)
 TEST(ReducedCorner, SameCh3SteadyStateAsTheConstrainedModel) {
   SteadyStateResult r[2];
   std::unique_ptr<FourWsVehicle> cars[2];
-  const char* models[2] = {"constrained", "reduced"};
   for (int m = 0; m < 2; ++m) {
-    cars[m] = ch3Car(models[m], "appendix_a_relaxation.json", true);
+    cars[m] = ch3Car(kModels[m], "appendix_a_relaxation.json", true);
     const Scene& sc = cars[m]->getScene();
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
     r[m] = solver.solve(cars[m]->makeInitialState(10.0));
@@ -212,25 +246,7 @@ TEST(ReducedCorner, SameCh3TransientAsTheConstrainedModel) {
   for (int c = 0; c < 4; ++c) EXPECT_NEAR(red->suspensionAngle(sr, c), con->suspensionAngle(sc, c), 1e-12) << cornerName(c);
   const SimTK::State mapped = red->makeStateLike(*con, sc);
   EXPECT_LT((mapped.getQ() - sr.getQ()).normInf(), 1e-12);
-  SimulationSettings sim;
-  sim.t_end_s = 2.5;
-  sim.report_interval_s = 0.05;
-  sim.integrator.accuracy = 1e-8;
-  sim.integrator.constraint_tolerance = 1e-10;
-  const std::vector<std::string> cols = {"chassis.yaw_rate_rad_s", "chassis.roll_rad", "front_steer.angle_rad"};
-  Recorder rc(con->getScene(), cols), rr(red->getScene(), cols);
-  simulate(con->getScene(), sc, sim, &rc);
-  simulate(red->getScene(), sr, sim, &rr);
-  ASSERT_EQ(rc.size(), rr.size());
-  for (const auto& n : cols) {
-    double scale = 0, err = 0;
-    for (std::size_t i = 0; i < rc.size(); ++i) {
-      scale = std::max(scale, std::abs(rc.column(n)[i]));
-      err = std::max(err, std::abs(rc.column(n)[i] - rr.column(n)[i]));
-    }
-    EXPECT_GT(scale, 1e-3) << n;  // the vehicle is turning: the comparison is not trivial
-    EXPECT_LT(err / scale, 1e-6) << n;
-  }
+  expectSameCh3Transient(con->getScene(), sc, red->getScene(), sr);
 }
 
 TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
@@ -238,12 +254,11 @@ TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
   // second of the chapter 3 manoeuvre (ch4_sensitivity --vehicle fourws), by
   // the mixed method on each model.
   SensitivityResult r[2];
-  const char* models[2] = {"constrained", "reduced"};
   for (int m = 0; m < 2; ++m) {
     SensitivityProblem p;
     p.model = SceneDesign::fromAnalysis(SceneDescription::fromFile(
         "scenes/ch4_sensitivity_fourws.json", standardRegistry(),
-        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.corner_model", models[m]}}));
+        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.corner_model", kModels[m]}}));
     p.parameters = {"front.spring.stiffness_N_per_m"};
     p.cost = CostFunctional::parse("integral_of_square:chassis.roll_rate_rad_s");
     p.t_end_s = 1.0;
@@ -263,11 +278,8 @@ TEST(ReducedDense, SameAccelerationsAsSimbodysRowsInTheSameState) {
   const auto red = ch3Car("reduced", "appendix_a_relaxation.json", false);
   const SimTK::MultibodySystem& sys = red->getScene().getSystem();
   SimTK::State s = red->makeInitialState(10.0);
-  SimulationSettings sim;
-  sim.t_end_s = 1.0;  // mid steering step: turning, rolling, steering rates non-zero
-  sim.integrator.accuracy = 1e-8;
-  sim.integrator.constraint_tolerance = 1e-10;
-  simulate(red->getScene(), s, sim, nullptr);
+  // To 1 s, mid steering step: turning, rolling, steering rates non-zero.
+  simulate(red->getScene(), s, ch3Simulation(1.0), nullptr);
   sys.project(s, 1e-14);  // on the constraint manifold: the Baumgarte terms vanish
   SimTK::State d = s;
   red->useDenseRows(d);
@@ -290,25 +302,7 @@ TEST(ReducedDense, SameCh3TransientAsSimbodysRows) {
   SimTK::State sr = red->makeInitialState(10.0);
   SimTK::State sd = sr;
   red->useDenseRows(sd);
-  SimulationSettings sim;
-  sim.t_end_s = 2.5;
-  sim.report_interval_s = 0.05;
-  sim.integrator.accuracy = 1e-8;
-  sim.integrator.constraint_tolerance = 1e-10;
-  const std::vector<std::string> cols = {"chassis.yaw_rate_rad_s", "chassis.roll_rad", "front_steer.angle_rad"};
-  Recorder rr(red->getScene(), cols), rd(red->getScene(), cols);
-  simulate(red->getScene(), sr, sim, &rr);
-  simulate(red->getScene(), sd, sim, &rd);
-  ASSERT_EQ(rr.size(), rd.size());
-  for (const auto& n : cols) {
-    double scale = 0, err = 0;
-    for (std::size_t i = 0; i < rr.size(); ++i) {
-      scale = std::max(scale, std::abs(rr.column(n)[i]));
-      err = std::max(err, std::abs(rr.column(n)[i] - rd.column(n)[i]));
-    }
-    EXPECT_GT(scale, 1e-3) << n;
-    EXPECT_LT(err / scale, 1e-6) << n;
-  }
+  ASSERT_NO_FATAL_FAILURE(expectSameCh3Transient(red->getScene(), sr, red->getScene(), sd));
   red->getScene().getSystem().realize(sd, SimTK::Stage::Velocity);
   const auto [perr, verr] = red->denseRows()->calcRowErrors(sd);
   EXPECT_LT(perr, 1e-9);  // drift held by the Baumgarte terms
