@@ -1,5 +1,7 @@
 #include "vdyn/vehicles/double_wishbone.h"
 
+#include "wishbone_corner.h"
+
 namespace vdyn {
 
 using SimTK::Vec3;
@@ -121,36 +123,16 @@ SimTK::Body::Rigid makeRigidBody(const RigidBodyParams& b) {
   return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
 }
 
-/// Frame at `point` whose z axis is `axis` (Simbody's Pin turns about z).
-static SimTK::Transform pinFrame(const Vec3& point, const SimTK::UnitVec3& axis) {
-  return SimTK::Transform(SimTK::Rotation(axis, SimTK::ZAxis), point);
-}
-
 DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& chassis,
                                          const DoubleWishboneParams& p, const std::string& prefix) {
-  p.validate(prefix + "corner");
   DoubleWishboneCorner c;
-  const SimTK::UnitVec3 a1 = p.lower_pivot.axis(), a4 = p.upper_pivot.axis();
-  c.lower_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.lower_pivot.parent_point_m, a1),
-                                          makeRigidBody(p.lower_arm), pinFrame(p.lower_pivot.child_point_m, a1));
-  c.knuckle = SimTK::MobilizedBody::Ball(c.lower_arm, SimTK::Transform(p.lower_ball.parent_point_m),
-                                         makeRigidBody(p.knuckle), SimTK::Transform(p.lower_ball.child_point_m));
-  c.upper_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.upper_pivot.parent_point_m, a4),
-                                          makeRigidBody(p.upper_arm), pinFrame(p.upper_pivot.child_point_m, a4));
-  const SimTK::UnitVec3 spin(p.wheel_spin_axis);
-  c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), makeRigidBody(p.wheel),
-                                      pinFrame(Vec3(0), spin));
+  buildWishboneCorner(scene, chassis, p, prefix, c, [&](DoubleWishboneCorner& k) {
+    k.knuckle = SimTK::MobilizedBody::Ball(k.lower_arm, SimTK::Transform(p.lower_ball.parent_point_m),
+                                           makeRigidBody(p.knuckle), SimTK::Transform(p.lower_ball.child_point_m));
+  });
+  // The loop cut at the upper ball (joint 3), closed by a constraint.
   c.upper_ball = SimTK::Constraint::Ball(c.upper_arm, p.upper_ball.parent_point_m, c.knuckle,
                                          p.upper_ball.child_point_m);
-  c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
-                                                p.spring_arm_point_m, p.spring_stiffness_N_per_m,
-                                                p.spring_free_length_m);
-  c.damper = SimTK::Force::TwoPointLinearDamper(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
-                                                p.spring_arm_point_m, p.damper_N_s_per_m);
-  scene.addBody(prefix + "lower_arm", c.lower_arm);
-  scene.addBody(prefix + "knuckle", c.knuckle);
-  scene.addBody(prefix + "upper_arm", c.upper_arm);
-  scene.addBody(prefix + "wheel", c.wheel);
   return c;
 }
 

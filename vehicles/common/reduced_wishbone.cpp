@@ -4,6 +4,7 @@
 #include <map>
 
 #include "vdyn/core/error.h"
+#include "wishbone_corner.h"
 
 namespace vdyn {
 
@@ -107,10 +108,6 @@ JV rotate(const JV& k, const Jet2& c, const Jet2& sn, const JV& w) {
 }
 
 double wrapToPi(double a) { return std::remainder(a, 2 * SimTK::Pi); }
-
-SimTK::Transform pinFrame(const Vec3& point, const SimTK::UnitVec3& axis) {
-  return SimTK::Transform(SimTK::Rotation(axis, SimTK::ZAxis), point);
-}
 }  // namespace
 
 // ---------------------------------------------------------------------------
@@ -433,29 +430,13 @@ void ArmPlanesImpl::addInPositionConstraintForces(const SimTK::State& s, const S
 // ---------------------------------------------------------------------------
 ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& chassis, const DoubleWishboneParams& p,
                                            const WishboneLoop& loop, const std::string& prefix) {
-  p.validate(prefix + "corner");
   ReducedWishboneCorner c;
   c.loop = &loop;
-  const SimTK::UnitVec3 a1 = p.lower_pivot.axis(), a4 = p.upper_pivot.axis();
-  c.lower_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.lower_pivot.parent_point_m, a1),
-                                          makeRigidBody(p.lower_arm), pinFrame(p.lower_pivot.child_point_m, a1));
-  auto* impl = new ReducedKnuckleMobilizer(scene.updMatter(), loop);
-  c.knuckle = SimTK::MobilizedBody::Custom(chassis, impl, makeRigidBody(p.knuckle));
-  impl->setMobilizedBody(c.knuckle.getMobilizedBodyIndex());
-  c.upper_arm = SimTK::MobilizedBody::Pin(chassis, pinFrame(p.upper_pivot.parent_point_m, a4),
-                                          makeRigidBody(p.upper_arm), pinFrame(p.upper_pivot.child_point_m, a4));
-  const SimTK::UnitVec3 spin(p.wheel_spin_axis);
-  c.wheel = SimTK::MobilizedBody::Pin(c.knuckle, pinFrame(Vec3(0), spin), makeRigidBody(p.wheel),
-                                      pinFrame(Vec3(0), spin));
-  c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
-                                                p.spring_arm_point_m, p.spring_stiffness_N_per_m,
-                                                p.spring_free_length_m);
-  c.damper = SimTK::Force::TwoPointLinearDamper(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
-                                                p.spring_arm_point_m, p.damper_N_s_per_m);
-  scene.addBody(prefix + "lower_arm", c.lower_arm);
-  scene.addBody(prefix + "knuckle", c.knuckle);
-  scene.addBody(prefix + "upper_arm", c.upper_arm);
-  scene.addBody(prefix + "wheel", c.wheel);
+  buildWishboneCorner(scene, chassis, p, prefix, c, [&](ReducedWishboneCorner& k) {
+    auto* impl = new ReducedKnuckleMobilizer(scene.updMatter(), loop);
+    k.knuckle = SimTK::MobilizedBody::Custom(chassis, impl, makeRigidBody(p.knuckle));
+    impl->setMobilizedBody(k.knuckle.getMobilizedBodyIndex());
+  });
   return c;
 }
 
