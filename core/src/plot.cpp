@@ -10,15 +10,6 @@
 namespace vdyn {
 
 namespace {
-std::string quote(const std::string& s) {
-  std::string q = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') q += '\\';
-    q += c;
-  }
-  return q + "\"";
-}
-
 const Table& findTable(const std::vector<std::pair<std::string, Table>>& tables, const std::string& name,
                        const std::string& plot) {
   for (const auto& [n, t] : tables)
@@ -43,28 +34,42 @@ std::size_t columnIndex(const Table& t, const std::string& c) {
   return std::size_t(std::find(t.columns.begin(), t.columns.end(), c) - t.columns.begin());
 }
 
-void runGnuplot(const std::string& png, const std::string& script) {
+/// Writes <png>.gp (the terminal, the output and `script`) and runs it.
+void renderPng(const std::string& png, const std::string& script) {
   const std::string gp = png + ".gp";
   {
     std::ofstream g(gp);
     if (!g) throw Error("cannot write '" + gp + "'");
-    g << "set terminal pngcairo size 1000,650 font 'sans,10'\nset output " << quote(png) << "\n"
+    g << "set terminal pngcairo size 1000,650 font 'sans,10'\nset output " << gnuplotQuote(png) << "\n"
       << "set datafile separator ','\nset grid\nset key noenhanced\n"
       << script;
   }
-  const std::string cmd = "gnuplot " + quote(gp) + " 2> " + quote(png + ".log");
+  runGnuplot(gp, png);
+}
+}  // namespace
+
+bool gnuplotAvailable() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
+
+std::string gnuplotQuote(const std::string& s) {
+  std::string q = "\"";
+  for (char c : s) {
+    if (c == '"' || c == '\\') q += '\\';
+    q += c;
+  }
+  return q + "\"";
+}
+
+void runGnuplot(const std::string& script, const std::string& png) {
+  const std::string cmd = "gnuplot " + gnuplotQuote(script) + " 2> " + gnuplotQuote(png + ".log");
   if (std::system(cmd.c_str()) != 0) {
     std::ifstream log(png + ".log");
     std::string line, last;
     while (std::getline(log, line))
       if (!line.empty()) last = line;
-    throw Error("gnuplot failed on '" + gp + "': " + last);
+    throw Error("gnuplot failed on '" + script + "': " + last);
   }
   std::remove((png + ".log").c_str());
 }
-}  // namespace
-
-bool gnuplotAvailable() { return std::system("command -v gnuplot > /dev/null 2>&1") == 0; }
 
 std::vector<std::string> renderPlots(const std::string& dir, const std::vector<std::pair<std::string, Table>>& tables,
                                      const std::vector<PlotSpec>& plots, int maxPanels) {
@@ -75,8 +80,8 @@ std::vector<std::string> renderPlots(const std::string& dir, const std::vector<s
   std::set<std::string> named;
   for (const PlotSpec& p : plots) {
     if (p.series.empty()) throw Error("plot '" + p.name + "': no series");
-    std::string s = "set title " + quote(p.title) + " noenhanced\nset xlabel " + quote(p.xlabel) +
-                    " noenhanced\nset ylabel " + quote(p.ylabel) + " noenhanced\n";
+    std::string s = "set title " + gnuplotQuote(p.title) + " noenhanced\nset xlabel " + gnuplotQuote(p.xlabel) +
+                    " noenhanced\nset ylabel " + gnuplotQuote(p.ylabel) + " noenhanced\n";
     if (p.equal_axes) s += "set size ratio -1\n";
     if (p.logx) s += "set logscale x\n";
     s += "plot ";
@@ -88,13 +93,14 @@ std::vector<std::string> renderPlots(const std::string& dir, const std::vector<s
       requireColumn(t, q.table, q.y, p.name);
       named.insert(q.table);
       if (!hasPoints(t, columnIndex(t, q.x), columnIndex(t, q.y))) continue;  // nothing to draw
-      s += std::string(drawn++ ? ", \\\n     " : "") + quote(dir + "/" + q.table + ".csv") + " using (column(" +
-           quote(q.x) + ")):(column(" + quote(q.y) + "))" + (p.points ? " with linespoints lw 2 pt 7" : " with lines lw 2") +
-           " title " + quote(q.label.empty() ? q.y : q.label);
+      s += std::string(drawn++ ? ", \\\n     " : "") + gnuplotQuote(dir + "/" + q.table + ".csv") + " using (column(" +
+           gnuplotQuote(q.x) + ")):(column(" + gnuplotQuote(q.y) + "))" +
+           (p.points ? " with linespoints lw 2 pt 7" : " with lines lw 2") + " title " +
+           gnuplotQuote(q.label.empty() ? q.y : q.label);
     }
     if (drawn == 0) continue;
     const std::string png = dir + "/" + p.name + ".png";
-    runGnuplot(png, s + "\n");
+    renderPng(png, s + "\n");
     written.push_back(png);
   }
   for (const auto& [name, t] : tables) {
@@ -106,18 +112,18 @@ std::vector<std::string> renderPlots(const std::string& dir, const std::vector<s
     const int n = std::min<int>(int(cols.size()), maxPanels);
     const int nc = n <= 3 ? 1 : (n <= 8 ? 2 : 3), rows = (n + nc - 1) / nc;
     std::string s = "set multiplot layout " + std::to_string(rows) + "," + std::to_string(nc) + " title " +
-                    quote(name + (int(cols.size()) > n ? " (first " + std::to_string(n) + " columns)" : "")) +
+                    gnuplotQuote(name + (int(cols.size()) > n ? " (first " + std::to_string(n) + " columns)" : "")) +
                     " noenhanced\nset key off\n";
     for (int k = 0; k < n; ++k) {
       const std::size_t i = cols[k];
-      s += "set title " + quote(t.columns[i]) + " noenhanced\nset xlabel " + quote(t.columns[0]) +
-           " noenhanced\nplot " + quote(dir + "/" + name + ".csv") + " using (column(" + quote(t.columns[0]) +
-           ")):(column(" + quote(t.columns[i]) + "))" + (t.rows.size() < 40 ? " with linespoints pt 7" : " with lines") +
-           " lw 2\n";
+      s += "set title " + gnuplotQuote(t.columns[i]) + " noenhanced\nset xlabel " + gnuplotQuote(t.columns[0]) +
+           " noenhanced\nplot " + gnuplotQuote(dir + "/" + name + ".csv") + " using (column(" +
+           gnuplotQuote(t.columns[0]) + ")):(column(" + gnuplotQuote(t.columns[i]) + "))" +
+           (t.rows.size() < 40 ? " with linespoints pt 7" : " with lines") + " lw 2\n";
     }
     s += "unset multiplot\n";
     const std::string png = dir + "/" + name + ".png";
-    runGnuplot(png, s);
+    renderPng(png, s);
     written.push_back(png);
   }
   return written;

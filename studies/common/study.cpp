@@ -13,6 +13,7 @@
 #include <unistd.h>
 
 #include "vdyn/core/file_io.h"
+#include "vdyn/core/plot.h"
 
 namespace vdyn::study {
 
@@ -198,27 +199,18 @@ void checkRunTimes(const Given& tEnd, const Given& dt) {
                 formatValue(tEnd.value / 1e6) + " s)");
 }
 
-static std::string quote(const std::string& s) {
-  std::string q = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') q += '\\';
-    q += c;
-  }
-  return q + "\"";
-}
-
 void plot(const std::vector<PlotSpec>& plots) {
-  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
+  if (!gnuplotAvailable())
     throw Error("gnuplot not found: the PNG plots need it (apt-get install gnuplot-nox)");
   for (const PlotSpec& p : plots) {
     const std::string script = p.png + ".gp";
     std::ofstream g(script);
     if (!g) throw Error("cannot write '" + script + "'");
     g << "set terminal pngcairo size 1000,650 font 'sans,10'\n"
-      << "set output " << quote(p.png) << "\n"
+      << "set output " << gnuplotQuote(p.png) << "\n"
       << "set datafile separator ','\nset key autotitle columnhead\nset grid\n"
-      << "set title " << quote(p.title) << " noenhanced\n"
-      << "set xlabel " << quote(p.xlabel) << " noenhanced\nset ylabel " << quote(p.ylabel) << " noenhanced\n"
+      << "set title " << gnuplotQuote(p.title) << " noenhanced\n"
+      << "set xlabel " << gnuplotQuote(p.xlabel) << " noenhanced\nset ylabel " << gnuplotQuote(p.ylabel) << " noenhanced\n"
       << "set key noenhanced\n";
     if (p.equal_axes) g << "set size ratio -1\n";
     if (p.logx) g << "set logscale x\nset format x '10^{%L}'\n";
@@ -226,7 +218,7 @@ void plot(const std::vector<PlotSpec>& plots) {
         g << "plot ";
     for (std::size_t i = 0; i < p.series.size(); ++i) {
       const Series& s = p.series[i];
-      std::string y = "column(" + quote(s.y) + ")";
+      std::string y = "column(" + gnuplotQuote(s.y) + ")";
       if (!s.filter.empty()) {
         std::string cond;
         std::size_t start = 0;
@@ -235,28 +227,20 @@ void plot(const std::vector<PlotSpec>& plots) {
           const std::string term = s.filter.substr(start, end - start);
           const auto eq = term.find('=');
           if (eq == std::string::npos) throw Error("plot filter '" + s.filter + "': expected column=value terms");
-          cond += (cond.empty() ? "" : " && ") + std::string("strcol(") + quote(term.substr(0, eq)) + ") eq " +
-                  quote(term.substr(eq + 1));
+          cond += (cond.empty() ? "" : " && ") + std::string("strcol(") + gnuplotQuote(term.substr(0, eq)) + ") eq " +
+                  gnuplotQuote(term.substr(eq + 1));
           start = end + 1;
         }
         y = "((" + cond + ") ? " + y + " : NaN)";
       }
-      g << (i ? ", \\\n     " : "") << quote(s.csv) << " using (column(" << quote(s.x) << ")):(" << y << ")"
+      g << (i ? ", \\\n     " : "") << gnuplotQuote(s.csv) << " using (column(" << gnuplotQuote(s.x) << ")):(" << y << ")"
         << (!s.style.empty() ? " " + s.style + " title "
                              : p.points ? std::string(" with linespoints lw 2 pt 7 title ") : " with lines lw 2 title ")
-        << quote(s.label);
+        << gnuplotQuote(s.label);
     }
     g << "\n";
     g.close();
-    const std::string cmd = "gnuplot " + quote(script) + " 2> " + quote(p.png + ".log");
-    if (std::system(cmd.c_str()) != 0) {
-      std::ifstream log(p.png + ".log");
-      std::string line, last;
-      while (std::getline(log, line))
-        if (!line.empty()) last = line;
-      throw Error("gnuplot failed on '" + script + "': " + last);
-    }
-    std::remove((p.png + ".log").c_str());
+    runGnuplot(script, p.png);
   }
 }
 

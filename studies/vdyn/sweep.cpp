@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "command.h"
+#include "vdyn/core/plot.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 #ifdef VDYN_HAVE_MPI
@@ -31,15 +32,6 @@ std::vector<Override> toOverrides(const std::vector<SweepSetting>& settings) {
   std::vector<Override> o;
   for (const auto& s : settings) o.push_back(Override{s.key, s.value});
   return o;
-}
-
-std::string gpQuote(const std::string& s) {
-  std::string q = "\"";
-  for (char c : s) {
-    if (c == '"' || c == '\\') q += '\\';
-    q += c;
-  }
-  return q + "\"";
 }
 
 std::string lastSegment(const std::string& path) {
@@ -78,25 +70,25 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
     std::ofstream g(script);
     if (!g) throw Error("cannot write '" + script + "'");
     g << "set terminal pngcairo size " << 640 * cols << "," << 480 * rows + 40 << " font 'sans,9'\n"
-      << "set output " << gpQuote(png) << "\nset datafile separator ','\nset grid\nset key noenhanced\n"
-      << "set xlabel " << gpQuote(p.x_label.empty() ? p.x : p.x_label) << " noenhanced\n"
-      << "set ylabel " << gpQuote(p.y_label.empty() ? p.y : p.y_label) << " noenhanced\n";
+      << "set output " << gnuplotQuote(png) << "\nset datafile separator ','\nset grid\nset key noenhanced\n"
+      << "set xlabel " << gnuplotQuote(p.x_label.empty() ? p.x : p.x_label) << " noenhanced\n"
+      << "set ylabel " << gnuplotQuote(p.y_label.empty() ? p.y : p.y_label) << " noenhanced\n";
     if (panels.size() > 1 || !p.title.empty())
-      g << "set multiplot layout " << rows << "," << cols << " title " << gpQuote(p.title) << " noenhanced\n";
+      g << "set multiplot layout " << rows << "," << cols << " title " << gnuplotQuote(p.title) << " noenhanced\n";
     for (const std::string& panel : panels) {
       if (!p.panels.empty())
-        g << "set title " << gpQuote((p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel)
+        g << "set title " << gnuplotQuote((p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel)
           << " noenhanced\n";
       g << "plot ";
       bool first = true;
       for (const std::string& s : series) {
         std::string cond = "strcol(\"status\") eq \"ok\"";
-        if (!p.panels.empty()) cond += " && strcol(" + gpQuote(p.panels) + ") eq " + gpQuote(panel);
-        if (!p.series.empty()) cond += " && strcol(" + gpQuote(p.series) + ") eq " + gpQuote(s);
-        g << (first ? "" : ", \\\n     ") << gpQuote(csv) << " using (column(" << gpQuote(p.x) << ")*" << formatValue(p.x_scale)
-          << "):((" << cond << ") ? column(" << gpQuote(p.y) << ")*" << formatValue(p.y_scale)
+        if (!p.panels.empty()) cond += " && strcol(" + gnuplotQuote(p.panels) + ") eq " + gnuplotQuote(panel);
+        if (!p.series.empty()) cond += " && strcol(" + gnuplotQuote(p.series) + ") eq " + gnuplotQuote(s);
+        g << (first ? "" : ", \\\n     ") << gnuplotQuote(csv) << " using (column(" << gnuplotQuote(p.x) << ")*" << formatValue(p.x_scale)
+          << "):((" << cond << ") ? column(" << gnuplotQuote(p.y) << ")*" << formatValue(p.y_scale)
           << " : NaN) with linespoints lw 2 pt 7 ps 0.6 title "
-          << gpQuote(p.series.empty() ? lastSegment(p.y)
+          << gnuplotQuote(p.series.empty() ? lastSegment(p.y)
                                       : (p.series_label.empty() ? lastSegment(p.series) : p.series_label) + " = " + s);
         first = false;
       }
@@ -104,15 +96,7 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
     }
     if (panels.size() > 1 || !p.title.empty()) g << "unset multiplot\n";
     g.close();
-    const std::string cmd = "gnuplot " + gpQuote(script) + " 2> " + gpQuote(png + ".log");
-    if (std::system(cmd.c_str()) != 0) {
-      std::ifstream log(png + ".log");
-      std::string line, last;
-      while (std::getline(log, line))
-        if (!line.empty()) last = line;
-      throw Error("gnuplot failed on '" + script + "': " + last);
-    }
-    std::remove((png + ".log").c_str());
+    runGnuplot(script, png);
   }
 }
 

@@ -13,6 +13,14 @@ namespace vdyn {
 /// True if gnuplot is on the PATH.
 bool gnuplotAvailable();
 
+/// `s` as a gnuplot string literal: in double quotes, `"` and `\` escaped.
+std::string gnuplotQuote(const std::string& s);
+
+/// Runs gnuplot on the script file `script` (which writes `png`); gnuplot's
+/// messages go to <png>.log, removed when it succeeds. Throws Error naming the
+/// script and gnuplot's last message when it fails.
+void runGnuplot(const std::string& script, const std::string& png);
+
 /// Renders `plots` (their tables already written as <out_dir>/<table>.csv)
 /// and, for every table no plot names, a default plot: each column against
 /// the first, one panel per column (at most `max_panels`, the rest listed in
