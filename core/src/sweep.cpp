@@ -820,6 +820,15 @@ std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepO
   return pending;
 }
 
+void finishSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
+                    std::chrono::steady_clock::time_point start, double cpu0) {
+  for (const auto& r : res.rows)
+    if (!r.ok) ++res.failed;
+  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  res.cpu_s = processCpuSeconds() - cpu0;
+  if (!o.out_dir.empty()) writeSweepOutputs(d, res, o.out_dir);
+}
+
 // --- the thread runner ------------------------------------------------------------
 SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, const SweepOptions& o) {
   if (o.threads < 1) throw Error("sweep: --threads must be at least 1, got " + std::to_string(o.threads));
@@ -870,11 +879,7 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
   }
   res.workers = threads;
   res.ran = prog.done;
-  for (const auto& r : res.rows)
-    if (!r.ok) ++res.failed;
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  res.cpu_s = processCpuSeconds() - cpu0;
-  if (!o.out_dir.empty()) writeSweepOutputs(d, res, o.out_dir);
+  finishSweepRun(d, o, res, t0, cpu0);
   return res;
 }
 

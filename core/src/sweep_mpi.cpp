@@ -201,11 +201,7 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   if (pendingCount == 0 && o.progress) o.progress(prog);
   res.workers = localThreads + size - 1;
   res.ran = prog.done;
-  for (const auto& r : res.rows)
-    if (!r.ok) ++res.failed;
-  res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  res.cpu_s = processCpuSeconds() - cpu0;
-  if (!o.out_dir.empty()) writeSweepOutputs(d, res, o.out_dir);
+  finishSweepRun(d, o, res, t0, cpu0);
   return res;
 }
 

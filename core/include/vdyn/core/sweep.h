@@ -21,6 +21,7 @@
 //    sweep_stats.json.
 // The MPI runner (vdyn/core/sweep_mpi.h, target vdyn_sweep_mpi) shares all of
 // this and differs only in who runs a variation.
+#include <chrono>
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
@@ -222,6 +223,11 @@ std::FILE* openSweepJournal(const std::string& dir, bool append);
 /// ascending.
 std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
                                          std::FILE*& journal);
+/// Ends a run of either runner: counts the failed rows into `res.failed`, sets
+/// `res.wall_s` and `res.cpu_s` (since `start` and processCpuSeconds() = `cpu0`)
+/// and writes the outputs into o.out_dir (writeSweepOutputs; none when "").
+void finishSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
+                    std::chrono::steady_clock::time_point start, double cpu0);
 /// results.csv text: variation,status,<keys>,<collect>,reason.
 std::string formatSweepCsv(const SweepDescription& d, const std::vector<SweepRow>& rows);
 /// results.json text.
