@@ -86,7 +86,8 @@ Json summarizeTransient(const BuiltScene& built, const TransientSettings& settin
             {"max_constraint_error", run.max_constraint_error},
             {"sim_time_s", run.sim_time_s},
             {"wall_time_s", run.wall_time_s},
-            {"real_time_factor", run.sim_time_s / run.wall_time_s}}},
+            {"real_time_factor", run.sim_time_s / run.wall_time_s},
+            {"warnings", run.warnings}}},
           {"vehicle", r.vehicle}};
 }
 
