@@ -226,6 +226,9 @@ TEST(Integrators, RunSaysWhenTheErrorEstimateDoesNotBoundTheError) {
       EXPECT_EQ(errorEstimateCaveat(IntegratorSettings{name, 1e-3}), "") << name;
     }
   }
+  // verlet: only at tight accuracies (its velocities are of lower order).
+  EXPECT_NE(errorEstimateCaveat(IntegratorSettings{"verlet", 1e-6}).find("does not bound"), std::string::npos);
+  EXPECT_EQ(errorEstimateCaveat(IntegratorSettings{"rk_merson", 1e-6}), "");
 }
 
 TEST(Simulation, RejectsEndTimeBeforeStart) {
