@@ -23,6 +23,26 @@ void IntegratorSettings::validate() const {
   requireNonNegative(max_step_s, "integrator max_step_s");
 }
 
+std::string errorEstimateCaveat(const IntegratorSettings& s) {
+  // Measured by build/bin/stress (benchmarks/stress.cpp): the worst cell's
+  // relative error against the rk_merson 1e-9 reference over the accuracy
+  // asked for (README "Stress matrix"). A caveat where that exceeded 100; the
+  // other methods and settings stayed below it (rk_feldberg 74 at 1e-3, cpodes
+  // 30 at 1e-6, rk3 14, rk_merson 3.4).
+  if (s.method == "semi_explicit_euler2")
+    return "integrator semi_explicit_euler2: its error estimate (step doubling of a first-order method) does not "
+           "bound the error of vehicle scenes, whose tire and damper forces depend on velocity: the stress matrix "
+           "(build/bin/stress) measured errors 267 times the accuracy at 1e-3 (4WS yaw rate, 2 m/s, 10 deg: 27 % "
+           "off) and 410 times at 1e-6 (quarter car cost) against a 1e-9 reference; use another method for results";
+  if (s.method == "verlet" && s.accuracy < 1e-4)
+    return "integrator verlet at accuracy " + formatValue(s.accuracy) +
+           ": its velocities are of lower order than its positions, so with the velocity-dependent tire and damper "
+           "forces of vehicle scenes its error estimate does not bound the error at tight accuracies: the stress "
+           "matrix (build/bin/stress) measured errors 342 times the accuracy at 1e-6 (quarter car cost; 4 times at "
+           "1e-3) against a 1e-9 reference; use rk_merson for tight results";
+  return "";
+}
+
 IntegratorSettings IntegratorSettings::fromParams(const ParamReader& r, IntegratorSettings d) {
   d.method = r.stringOr("method", d.method);
   d.accuracy = r.numberOr("accuracy", d.accuracy);

@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <mutex>
+#include <set>
 
 namespace vdyn {
 
@@ -71,6 +73,14 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   RunSummary sum;
   sum.integrator = s.integrator.method;
   sum.accuracy = s.integrator.accuracy;
+  if (const std::string caveat = errorEstimateCaveat(s.integrator); !caveat.empty()) {
+    sum.warnings.push_back(caveat);
+    // Said once per process on stderr (a sweep may run thousands of cells).
+    static std::mutex m;
+    static std::set<std::string> said;
+    const std::lock_guard<std::mutex> lock(m);
+    if (said.insert(caveat).second) std::fprintf(stderr, "vdyn: warning: %s\n", caveat.c_str());
+  }
   const auto wall0 = std::chrono::steady_clock::now();
 
   auto integ = makeIntegrator(scene.getSystem(), s.integrator);

@@ -20,7 +20,7 @@ srcs=(tests/fuzz/fuzz_params.cpp core/src/params.cpp core/src/scene_file.cpp cor
 if [ ! -x "$out/fuzz_params" ] || [ -n "$(find "${srcs[@]}" core/include -newer "$out/fuzz_params" | head -1)" ]; then
   echo "building $out/fuzz_params"
   incs=()
-  for d in core/include plugins/*/include vehicles/include; do incs+=(-I"$d"); done
+  for d in core/include plugins/include plugins/*/include vehicles/include; do incs+=(-I"$d"); done
   libs=()
   for l in build/lib/libvdyn_*.so; do
     case $l in *fixture*) ;; *) libs+=("$PWD/$l") ;; esac
@@ -32,7 +32,7 @@ if [ ! -x "$out/fuzz_params" ] || [ -n "$(find "${srcs[@]}" core/include -newer 
     -o "$out/fuzz_params"
 fi
 echo "fuzzing for ${budget} s"
-UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 \
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 par=()
 [ "$jobs" -gt 1 ] && par=(-fork="$jobs")
 "$out/fuzz_params" "$out/corpus" tests/fuzz/corpus -max_total_time="$budget" "${par[@]}" \

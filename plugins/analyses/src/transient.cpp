@@ -18,7 +18,9 @@ const FieldTable<TransientSettings>& TransientSettings::fields() {
                   })
           .strings("integrals_of_square", &TransientSettings::integrals_of_square,
                    "outputs y whose int y^2 dt is integrated with error control (cost, seed 4.46)")
-          .boolean("write_history", &TransientSettings::write_history, "write history.csv of the recorded outputs");
+          .boolean("write_history", &TransientSettings::write_history, "write history.csv of the recorded outputs")
+          .number("wall_time_budget_s", &TransientSettings::wall_time_budget_s, "s",
+                  "wall-clock budget of the run (0 = none): beyond it the run stops with a named error");
   return t;
 }
 
@@ -27,6 +29,7 @@ SimulationSettings TransientSettings::simulation() const {
   s.t_end_s = t_end_s;
   s.report_interval_s = report_interval_s;
   s.integrator = integrator;
+  s.wall_time_budget_s = wall_time_budget_s;
   return s;
 }
 
@@ -83,7 +86,8 @@ Json summarizeTransient(const BuiltScene& built, const TransientSettings& settin
             {"max_constraint_error", run.max_constraint_error},
             {"sim_time_s", run.sim_time_s},
             {"wall_time_s", run.wall_time_s},
-            {"real_time_factor", run.sim_time_s / run.wall_time_s}}},
+            {"real_time_factor", run.sim_time_s / run.wall_time_s},
+            {"warnings", run.warnings}}},
           {"vehicle", r.vehicle}};
 }
 

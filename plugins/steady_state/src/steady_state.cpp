@@ -398,6 +398,10 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
     block("max position-constraint error", res.position_error, opt_.position_tolerance, "");
     block("max velocity-constraint error", res.velocity_error, opt_.velocity_tolerance, "");
     block("max zdot", res.rate_residual, opt_.rate_tolerance, "");
+    // The extra conditions are part of convergence too (conditionsMet): each named.
+    for (int i = 0; i < np_; ++i)
+      block(("condition '" + problem_.conditions[i].name + "'").c_str(), std::abs(r[nu_ + m_ + nz_ + i]),
+            problem_.conditions[i].tolerance, "");
     throw SteadyStateError(
         std::string("steady state did not converge") + (stalled ? " (no descent along the Newton direction)" : "") +
         ": " + std::to_string(res.iterations) + " iterations; failing: " + failing + "; " + blocksText +

@@ -2,6 +2,7 @@
 // Time integration of a finalized Scene with run statistics.
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "vdyn/core/integrators.h"
 #include "vdyn/core/recorder.h"
@@ -48,6 +49,9 @@ struct RunSummary {
   double max_constraint_error = 0;
   double sim_time_s = 0;      ///< simulated time
   double wall_time_s = 0;     ///< wall-clock time of the integration
+  /// Caveats about the run's figures, one line each (errorEstimateCaveat():
+  /// an integrator whose error estimate does not bound the error here).
+  std::vector<std::string> warnings;
 };
 
 /// One line describing where a run is: time, and where the scene has them the

@@ -31,6 +31,9 @@ struct TransientSettings {
   /// Outputs y whose int_0^T y^2 dt is carried as an error-controlled state (seed 4.46).
   std::vector<std::string> integrals_of_square;
   bool write_history = true;          ///< write history.csv of the recorded outputs
+  /// Wall-clock budget of the run, s (0 = none): beyond it simulate() stops
+  /// with a named error saying where (SimulationSettings::wall_time_budget_s).
+  double wall_time_budget_s = 0;
 
   static const FieldTable<TransientSettings>& fields();
   SimulationSettings simulation() const;
