@@ -24,6 +24,11 @@ using namespace vdyn;
 namespace {
 const double kDeg = SimTK::Pi / 180;
 
+/// `digits` significant digits, `missing` for a value that is not there (non-finite).
+std::string sig(double v, int digits = 4, const char* missing = "-") {
+  return std::isfinite(v) ? formatSig(v, digits) : missing;
+}
+
 struct Config {
   ParamReader data;
   FourWsParams fourws;
@@ -96,14 +101,15 @@ Json iso4138(const Config& c, const std::string& vehicle, const std::string& out
                           "understeer_gradient_at_6_m_s2_deg_per_m_s2"})
       if (!std::isfinite(jr[k].get<double>())) jr[k] = nullptr;
     j.push_back(jr);
-    std::printf("  ISO 4138 %-14s R %5.0f m: %2zu points, limit a_y %.3f m/s^2 at %.3f m/s%s, K(0) %+.4f deg/(m/s^2), "
-                "stability lost %s, %.3f s (solves %.3f s)\n",
-                vehicle.c_str(), R, r.points.size(), r.limit_lateral_accel_m_s2, r.limit_speed_m_s,
-                r.limit_found ? "" : " (speed_max)", r.understeer_gradient_linear_rad_per_m_s2 / kDeg,
+    std::printf("  ISO 4138 %-14s R %g m: %zu points, limit a_y %s m/s^2 at %s m/s%s, K(0) %s deg/(m/s^2), "
+                "stability lost %s, %s s (solves %s s)\n",
+                vehicle.c_str(), R, r.points.size(), sig(r.limit_lateral_accel_m_s2).c_str(),
+                sig(r.limit_speed_m_s).c_str(), r.limit_found ? "" : " (speed_max)",
+                sig(r.understeer_gradient_linear_rad_per_m_s2 / kDeg).c_str(),
                 std::isfinite(r.stability_lost_lateral_accel_m_s2)
-                    ? ("at " + formatValue(r.stability_lost_lateral_accel_m_s2) + " m/s^2").c_str()
+                    ? ("at " + sig(r.stability_lost_lateral_accel_m_s2) + " m/s^2").c_str()
                     : "never",
-                r.wall_time_s, r.solve_wall_time_s);
+                sig(r.wall_time_s, 3).c_str(), sig(r.solve_wall_time_s, 3).c_str());
     const std::string lab = "R " + formatValue(R) + " m";
     sd.push_back({csv, "lateral_accel_m_s2", "front_deg", lab});
     sb.push_back({csv, "lateral_accel_m_s2", "side_slip_deg", lab});
@@ -180,12 +186,15 @@ Json iso7401(const Config& c, const std::string& vehicle, const std::string& out
   const FrequencyResponsePoint at1 = frAt(1.0);
   j["yaw_phase_at_1Hz_deg"] = at1.yaw_phase_deg;
   j["ay_phase_at_1Hz_deg"] = at1.ay_phase_deg;
-  std::printf("  ISO 7401 %-14s step to %.2f deg: r/delta %.4f 1/s, response time %.4f s, peak time %.4f s, overshoot "
-              "%.2f %%; a_y response %.4f s; FR: yaw phase at 1 Hz %.2f deg, a_y phase %.2f deg, peak gain x%.3f at "
-              "%.2f Hz\n",
-              vehicle.c_str(), st.front_rad / kDeg, st.yaw_rate_gain_1_per_s, st.yaw_response_time_s,
-              st.yaw_peak_response_time_s, 100 * st.yaw_overshoot, st.lateral_accel_response_time_s,
-              at1.yaw_phase_deg, at1.ay_phase_deg, gPeak / fr.yaw_gain_zero_1_per_s, fPeak);
+  std::printf("  ISO 7401 %-14s step to %s deg: r/delta %s 1/s, response time %s s, peak response time %s, overshoot "
+              "%s %%; a_y response time %s s; FR: yaw phase at 1 Hz %s deg, a_y phase %s deg, peak gain x%s at %s Hz\n",
+              vehicle.c_str(), sig(st.front_rad / kDeg).c_str(), sig(st.yaw_rate_gain_1_per_s).c_str(),
+              sig(st.yaw_response_time_s, 3).c_str(),
+              std::isfinite(st.yaw_peak_response_time_s) ? (sig(st.yaw_peak_response_time_s, 3) + " s").c_str()
+                                                         : "- (no peak: monotone rise)",
+              sig(100 * st.yaw_overshoot, 3).c_str(), sig(st.lateral_accel_response_time_s, 3).c_str(),
+              sig(at1.yaw_phase_deg, 3).c_str(), sig(at1.ay_phase_deg, 3).c_str(),
+              sig(gPeak / fr.yaw_gain_zero_1_per_s, 3).c_str(), sig(fPeak, 3).c_str());
   if (check) {
     Json cj = Json::array();
     IntegratorSettings integ = set.integrator;
@@ -234,37 +243,63 @@ Json sineWithDwell(const Config& c, const std::string& vehicle, const std::strin
   const std::string t = fileTag(vehicle);
   Json runs = Json::array();
   std::vector<study::Series> ser;
-  double worst1 = 0, worst175 = 0, minDisp = 1e300;
-  int failedRuns = 0;
+  // Ratios and displacement over the completed runs only; a spun-out or failed
+  // run has no number: it is counted, and the first one named.
+  double worst1 = -1e300, worst175 = -1e300, minDisp = 1e300;
+  int spun = 0, failed = 0, completedFrom5 = 0;
+  std::string firstFail;  // the smallest amplitude that fails, and why
+  double firstFailFactor = std::nan("");
   for (const auto& run : r.runs) {
     Json jr = {{"factor", run.factor}, {"amplitude_deg", run.amplitude_rad / kDeg}, {"completed", run.completed},
-               {"pass", run.pass}};
+               {"spun_out", run.spun_out}, {"pass", run.pass}};
     if (run.completed) {
       const std::string csv = out + "/swd_" + t + "_" + formatValue(run.factor) + "A.csv";
       run.history.writeCsv(csv);
       ser.push_back({csv, "t_s", "yaw_rate_rad_s", formatValue(run.factor) + " A"});
       jr["peak_yaw_rate_rad_s"] = run.peak_yaw_rate_rad_s;
+      jr["peak_time_s"] = run.peak_time_s;
       jr["yaw_ratio_1s"] = run.yaw_ratio_1s;
       jr["yaw_ratio_1_75s"] = run.yaw_ratio_175;
       jr["lateral_displacement_m"] = run.lateral_displacement_m;
       worst1 = std::max(worst1, run.yaw_ratio_1s);
       worst175 = std::max(worst175, run.yaw_ratio_175);
-      if (run.factor >= set.displacement_from_factor - 1e-9) minDisp = std::min(minDisp, run.lateral_displacement_m);
+      if (run.factor >= set.displacement_from_factor - 1e-9) {
+        minDisp = std::min(minDisp, run.lateral_displacement_m);
+        ++completedFrom5;
+      }
     } else {
       jr["reason"] = run.reason;
-      ++failedRuns;
+      ++(run.spun_out ? spun : failed);
     }
+    if (!run.pass && firstFail.empty()) firstFailFactor = run.factor;
+    if (!run.pass && firstFail.empty())
+      firstFail = (run.spun_out ? "spin" : !run.completed ? "failed" : run.yaw_ratio_1s > set.yaw_ratio_1s_limit ? "r1.0"
+                   : run.yaw_ratio_175 > set.yaw_ratio_175_limit ? "r1.75" : "disp") + std::string(" ") +
+                  formatValue(run.factor) + "A";
     runs.push_back(jr);
   }
-  std::printf("  SWD      %-14s A %.3f deg, %zu runs (%d spun/failed): max ratio 1.0 s %.3f, 1.75 s %.3f, min "
-              "displacement (>= 5A) %.3f m -> %s\n",
-              vehicle.c_str(), r.angle_A_rad / kDeg, r.runs.size(), failedRuns, worst1, worst175,
-              minDisp < 1e300 ? minDisp : std::nan(""), r.pass ? "PASS" : "FAIL");
+  const int completed = int(r.runs.size()) - spun - failed;
+  std::printf("  SWD      %-14s A %.3f deg, %zu runs: %d completed, %d spun out, %d failed; completed runs: max ratio "
+              "1.0 s %s, 1.75 s %s; displacement from %g A %s -> %s%s\n",
+              vehicle.c_str(), r.angle_A_rad / kDeg, r.runs.size(), completed, spun, failed,
+              completed ? sig(worst1, 3).c_str() : "-", completed ? sig(worst175, 3).c_str() : "-",
+              set.displacement_from_factor,
+              completedFrom5 ? ("min " + sig(minDisp, 3) + " m").c_str() : "(no run completed)",
+              r.pass ? "PASS" : "FAIL", firstFail.empty() ? "" : (" (first: " + firstFail + ")").c_str());
   if (plots && !ser.empty())
     study::plot({{out + "/swd_" + t + ".png", "sine with dwell " + vehicle, "t (s)", "yaw rate (rad/s)", ser}});
-  return {{"angle_A_deg", r.angle_A_rad / kDeg}, {"runs", runs}, {"pass", r.pass},
-          {"max_yaw_ratio_1s", worst1},      {"max_yaw_ratio_1_75s", worst175},
-          {"min_lateral_displacement_m", minDisp < 1e300 ? Json(minDisp) : Json(nullptr)}, {"failed_runs", failedRuns}};
+  auto orNull = [](bool have, double x) { return have ? Json(x) : Json(nullptr); };
+  return {{"angle_A_deg", r.angle_A_rad / kDeg},
+          {"runs", runs},
+          {"pass", r.pass},
+          {"completed_runs", completed},
+          {"spun_out_runs", spun},
+          {"failed_runs", failed},
+          {"first_fail", firstFail.empty() ? Json(nullptr) : Json(firstFail)},
+          {"first_fail_factor", orNull(!firstFail.empty(), firstFailFactor)},
+          {"max_yaw_ratio_1s", orNull(completed > 0, worst1)},
+          {"max_yaw_ratio_1_75s", orNull(completed > 0, worst175)},
+          {"min_lateral_displacement_m", orNull(completedFrom5 > 0, minDisp)}};
 }
 Json iso3888(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
   const ParamReader p = c.data.child("iso3888");
@@ -277,14 +312,108 @@ Json iso3888(const Config& c, const std::string& vehicle, const std::string& out
   opt.out_dir = out + "/iso3888_" + fileTag(vehicle);
   opt.plots = plots;
   const Json s = runScene(scene, opt);
-  std::printf("  ISO 3888-2 %-12s highest passing entry speed %.3f m/s (%.1f km/h), lowest failing %s m/s, %zu runs, "
-              "min clearance %.3f m, %.1f s\n",
-              vehicle.c_str(), s["highest_pass_m_s"].get<double>(), s["highest_pass_km_h"].get<double>(),
-              s["lowest_fail_m_s"].is_number() ? formatValue(s["lowest_fail_m_s"].get<double>()).c_str() : "-",
-              s["runs"].size(), s["best_min_clearance_m"].get<double>(), s["wall_time_s"].get<double>());
+  auto numOr = [](const Json& j) { return j.is_number() ? j.get<double>() : std::nan(""); };
+  std::printf("  ISO 3888-2 %-12s highest passing entry speed %s m/s (%s km/h), lowest failing %s m/s, %zu runs, "
+              "min clearance %s m, %s s\n",
+              vehicle.c_str(), sig(numOr(s["highest_pass_m_s"])).c_str(), sig(numOr(s["highest_pass_km_h"])).c_str(),
+              sig(numOr(s["lowest_fail_m_s"])).c_str(), s["runs"].size(), sig(numOr(s["best_min_clearance_m"]), 3).c_str(),
+              sig(numOr(s["wall_time_s"]), 3).c_str());
   return {{"highest_pass_m_s", s["highest_pass_m_s"]}, {"lowest_fail_m_s", s["lowest_fail_m_s"]},
           {"top_of_bracket_passes", s["top_of_bracket_passes"]}, {"bracket_m_s", s["bracket_m_s"]},
           {"tolerance_m_s", s["tolerance_m_s"]}, {"runs", s["runs"].size()}, {"out_dir", opt.out_dir}};
+}
+
+/// The 2WS / 4WS table: one row per vehicle run, the App. A strategies ranked
+/// per test (1 = best; ties share a rank) and overall by their mean rank (ties:
+/// the ISO 3888-2 speed). Open loop except ISO 3888-2 (closed loop: path
+/// controller, rear-steer law with its G1/G2 tracking). Ranked on: ISO 4138
+/// limit a_y at R = 100 m (higher), ISO 7401 yaw response time (shorter), SWD
+/// (pass; else the higher first failing amplitude), ISO 3888-2 highest passing
+/// entry speed (higher). The bicycle, if run, is listed unranked.
+void printRanking(const Json& summary, const std::vector<std::string>& vehicles) {
+  struct Row {
+    std::string name;
+    double ay = NAN, k0 = NAN, lost = NAN, tr = NAN, tpk = NAN, os = NAN, swdScore = NAN, r1 = NAN, dlc = NAN;
+    bool has4138 = false, has7401 = false, hasSwd = false, hasDlc = false;
+    std::string swd = "-";
+    int rank[4] = {0, 0, 0, 0};
+    double mean = NAN;
+  };
+  auto num = [](const Json& j, const char* k) {
+    return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan("");
+  };
+  std::vector<Row> rows;
+  for (const auto& v : vehicles) {
+    const Json& jv = summary[v];
+    Row r;
+    r.name = v;
+    if ((r.has4138 = jv.contains("iso4138") && !jv["iso4138"].empty())) {
+      const Json& j = jv["iso4138"][0];  // the first radius (R = 100 m in handling.json)
+      r.ay = num(j, "limit_lateral_accel_m_s2"), r.k0 = num(j, "understeer_gradient_linear_deg_per_m_s2");
+      r.lost = num(j, "stability_lost_lateral_accel_m_s2");
+    }
+    if ((r.has7401 = jv.contains("iso7401"))) {
+      const Json& j = jv["iso7401"];
+      r.tr = num(j, "yaw_response_time_s"), r.tpk = num(j, "yaw_peak_response_time_s"), r.os = num(j, "yaw_overshoot");
+    }
+    if ((r.hasSwd = jv.contains("sine_with_dwell"))) {
+      const Json& j = jv["sine_with_dwell"];
+      const bool pass = j["pass"].get<bool>();
+      // Pass scores above every failing amplitude; a failure scores its amplitude.
+      r.swdScore = pass ? 1e9 : num(j, "first_fail_factor");
+      r.swd = pass ? "pass" : "FAIL " + j["first_fail"].get<std::string>();
+      r.r1 = num(j, "max_yaw_ratio_1s");
+    }
+    if ((r.hasDlc = jv.contains("iso3888"))) r.dlc = 3.6 * num(jv["iso3888"], "highest_pass_m_s");
+    rows.push_back(r);
+  }
+  // Competition ranks among the App. A rows ("4ws/..."), per test.
+  auto rankBy = [&](int col, auto has, auto value, bool higherBetter) {
+    for (auto& a : rows) {
+      if (a.name.rfind("4ws/", 0) != 0 || !has(a) || !std::isfinite(value(a))) continue;
+      int k = 1;
+      for (const auto& b : rows)
+        if (b.name.rfind("4ws/", 0) == 0 && has(b) && std::isfinite(value(b)) &&
+            (higherBetter ? value(b) > value(a) : value(b) < value(a)))
+          ++k;
+      a.rank[col] = k;
+    }
+  };
+  rankBy(0, [](const Row& r) { return r.has4138; }, [](const Row& r) { return r.ay; }, true);
+  rankBy(1, [](const Row& r) { return r.has7401; }, [](const Row& r) { return r.tr; }, false);
+  rankBy(2, [](const Row& r) { return r.hasSwd; }, [](const Row& r) { return r.swdScore; }, true);
+  rankBy(3, [](const Row& r) { return r.hasDlc; }, [](const Row& r) { return r.dlc; }, true);
+  for (auto& r : rows) {
+    double sum = 0;
+    int n = 0;
+    for (int k : r.rank)
+      if (k > 0) sum += k, ++n;
+    if (n) r.mean = sum / n;
+  }
+  std::stable_sort(rows.begin(), rows.end(), [](const Row& a, const Row& b) {
+    const bool ra = std::isfinite(a.mean), rb = std::isfinite(b.mean);
+    if (ra != rb) return ra;
+    if (ra && a.mean != b.mean) return a.mean < b.mean;
+    return (std::isfinite(a.dlc) ? a.dlc : -1) > (std::isfinite(b.dlc) ? b.dlc : -1);
+  });
+  auto cell = [](const std::string& v, int rank) { return rank > 0 ? v + " (" + std::to_string(rank) + ")" : v; };
+  std::printf("\n  2WS / 4WS (App. A vehicle; rank per test in parentheses, 1 = best; overall = mean rank)\n");
+  std::printf("  %-4s %-14s | %-16s %-9s %-10s | %-12s %-10s %-9s | %-18s %-8s | %-14s\n", "rank", "vehicle",
+              "4138 ay_lim m/s2", "K0 d/mps2", "unstable", "7401 t_r90 s", "t_peak s", "overshoot", "SWD", "r1.0max",
+              "3888-2 km/h");
+  int place = 0;
+  for (const auto& r : rows) {
+    const std::string rk = std::isfinite(r.mean) ? std::to_string(++place) : "-";
+    std::printf("  %-4s %-14s | %-16s %-9s %-10s | %-12s %-10s %-9s | %-18s %-8s | %-14s\n", rk.c_str(),
+                r.name.c_str(), cell(sig(r.ay), r.rank[0]).c_str(), sig(r.k0, 3).c_str(),
+                r.has4138 ? (std::isfinite(r.lost) ? sig(r.lost, 3).c_str() : "never") : "-",
+                cell(sig(r.tr, 3), r.rank[1]).c_str(), r.has7401 ? sig(r.tpk, 3, "no peak").c_str() : "-",
+                r.has7401 ? (sig(100 * r.os, 2) + " %").c_str() : "-", cell(r.swd, r.rank[2]).c_str(),
+                sig(r.r1, 3).c_str(), cell(sig(r.dlc, 3), r.rank[3]).c_str());
+  }
+  std::printf("  K0 d/mps2: understeer gradient at zero a_y, deg/(m/s^2); unstable: a_y (m/s^2) where the "
+              "R = 100 m sweep loses stability; SWD: pass, or the first failing amplitude and why (spin, r1.0 / r1.75 "
+              "ratio, disp); r1.0max: largest 1.0 s yaw-rate ratio of the completed runs\n");
 }
 }  // namespace
 
@@ -328,32 +457,7 @@ int main(int argc, char** argv) {
       }
       summary[v] = jv;
     }
-    // 2WS / 4WS ranking on the 4WS vehicle (strategies run): one row per strategy.
-    // Closed loop (path controller, rear-steer law with G1/G2 tracking): only
-    // the ISO 3888-2 column; the others are open loop (the rear angle is the
-    // strategy's target exactly). Ranked by the ISO 3888-2 speed when run.
-    std::vector<std::string> order = vehicles;
-    auto dlc = [&](const std::string& v) {
-      const Json& jv = summary[v];
-      return jv.contains("iso3888") ? jv["iso3888"]["highest_pass_m_s"].get<double>() : -1.0;
-    };
-    std::stable_sort(order.begin(), order.end(), [&](const std::string& a, const std::string& b) { return dlc(a) > dlc(b); });
-    std::printf("\n  %-14s %10s %10s %10s %10s %10s %10s %8s %12s\n", "vehicle", "ay_lim100", "K0_deg", "t_r90_s",
-                "overshoot", "r_gain", "swd_r1", "swd", "dlc_pass_kmh");
-    for (const auto& v : order) {
-      const Json& jv = summary[v];
-      auto num = [](const Json& j, const char* k) { return j.contains(k) && j[k].is_number() ? j[k].get<double>() : std::nan(""); };
-      const double ay = jv.contains("iso4138") ? num(jv["iso4138"][0], "limit_lateral_accel_m_s2") : std::nan("");
-      const double k0 = jv.contains("iso4138") ? num(jv["iso4138"][0], "understeer_gradient_linear_deg_per_m_s2") : std::nan("");
-      const double tr = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_response_time_s") : std::nan("");
-      const double os = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_overshoot") : std::nan("");
-      const double rg = jv.contains("iso7401") ? num(jv["iso7401"], "yaw_rate_gain_1_per_s") : std::nan("");
-      const double r1 = jv.contains("sine_with_dwell") ? num(jv["sine_with_dwell"], "max_yaw_ratio_1s") : std::nan("");
-      const std::string swd = jv.contains("sine_with_dwell") ? (jv["sine_with_dwell"]["pass"].get<bool>() ? "pass" : "FAIL") : "-";
-      const double dl = jv.contains("iso3888") ? 3.6 * num(jv["iso3888"], "highest_pass_m_s") : std::nan("");
-      std::printf("  %-14s %10.3f %+10.4f %10.4f %10.4f %10.4f %10.4f %8s %12.1f\n", v.c_str(), ay, k0, tr, os, rg, r1,
-                  swd.c_str(), dl);
-    }
+    printRanking(summary, vehicles);
     study::writeJson(out + "/summary.json", summary);
   });
 }

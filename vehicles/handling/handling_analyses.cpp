@@ -170,12 +170,15 @@ class SineWithDwellAnalysis : public Analysis {
     const SineWithDwellResult r = runSineWithDwell(b->vehicle, s_);
     AnalysisResult res;
     Table t;
-    t.columns = {"factor", "amplitude_deg", "completed", "yaw_ratio_1s", "yaw_ratio_1_75s", "lateral_displacement_m", "pass"};
+    // A spun-out or failed run has no ratios (NaN cells, the reason in the summary).
+    t.columns = {"factor", "amplitude_deg", "completed", "spun_out", "peak_yaw_rate_rad_s", "yaw_ratio_1s",
+                 "yaw_ratio_1_75s", "lateral_displacement_m", "pass"};
     Json runs = Json::array();
     for (const auto& q : r.runs) {
-      t.rows.push_back({q.factor, q.amplitude_rad / kDeg, double(q.completed), q.completed ? q.yaw_ratio_1s : NAN,
+      t.rows.push_back({q.factor, q.amplitude_rad / kDeg, double(q.completed), double(q.spun_out),
+                        q.completed ? q.peak_yaw_rate_rad_s : NAN, q.completed ? q.yaw_ratio_1s : NAN,
                         q.completed ? q.yaw_ratio_175 : NAN, q.completed ? q.lateral_displacement_m : NAN, double(q.pass)});
-      Json j = {{"factor", q.factor}, {"completed", q.completed}, {"pass", q.pass}};
+      Json j = {{"factor", q.factor}, {"completed", q.completed}, {"spun_out", q.spun_out}, {"pass", q.pass}};
       if (!q.completed) j["reason"] = q.reason;
       runs.push_back(j);
     }
@@ -373,6 +376,11 @@ class VehicleReportAnalysis : public Analysis {
   double range_, step_;
 };
 
+std::vector<FieldInfo> concat(std::vector<FieldInfo> a, const std::vector<FieldInfo>& b) {
+  a.insert(a.end(), b.begin(), b.end());
+  return a;
+}
+
 std::vector<FieldInfo> withVehicleKeys(std::vector<FieldInfo> f) {
   f.insert(f.end(), kVehicleKeys.begin(), kVehicleKeys.end());
   return f;
@@ -394,29 +402,15 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
       "iso7401", [](const ParamReader& r) { return std::make_unique<Iso7401Analysis>(r); },
       {"ISO 7401 step steer (simulation) and frequency response (linearisation about straight running); tables "
        "step_steer.csv, frequency_response.csv",
-       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "test speed"},
-                        {"lateral_accel_m_s2", "m/s^2", "4", "steady lateral acceleration of the step"},
-                        {"step_start_s", "s", "0.5", "start of the steering ramp"},
-                        {"ramp_time_s", "s", "0.15", "ramp duration (smooth step 7.4)"},
-                        {"duration_s", "s", "4", "simulated time after the ramp starts"},
-                        {"sample_s", "s", "0.002", "sampling interval"},
-                        {"integrator", "-", "rk_merson 1e-6", "integrator settings"},
-                        {"frequency_from_Hz", "Hz", "0.1", "lowest frequency"},
-                        {"frequency_to_Hz", "Hz", "4", "highest frequency"},
-                        {"frequency_count", "", "25", "log-spaced frequencies"}})});
+       withVehicleKeys(concat(StepSteerSettings::fields().describe(),
+                              {{"frequency_from_Hz", "Hz", "0.1", "lowest frequency"},
+                               {"frequency_to_Hz", "Hz", "4", "highest frequency"},
+                               {"frequency_count", "", "25", "log-spaced frequencies"}}))});
   registry.addAnalysis(
       "sine_with_dwell", [](const ParamReader& r) { return std::make_unique<SineWithDwellAnalysis>(r); },
       {"FMVSS 126 sine with dwell: A at 0.3 g (steady state), 0.7 Hz sine with 500 ms dwell from 1.5 A; yaw-rate "
        "ratios and lateral displacement against the limits; table sine_with_dwell.csv",
-       withVehicleKeys({{"speed_m_s", "m/s", "22.22", "entry speed (held up to the beginning of steer)"},
-                        {"lateral_accel_m_s2", "m/s^2", "2.943", "lateral acceleration defining A"},
-                        {"frequency_Hz", "Hz", "0.7", "sine frequency"},
-                        {"dwell_s", "s", "0.5", "dwell at the second peak"},
-                        {"first_factor", "", "1.5", "first amplitude / A"},
-                        {"factor_step", "", "0.5", "amplitude increment / A"},
-                        {"max_amplitude_factor", "", "6.5", "last amplitude / A"},
-                        {"max_amplitude_rad", "rad", "0.35", "cap on the road-wheel amplitude"},
-                        {"coast", "-", "true", "coast from the beginning of steer (false: speed held)"}})});
+       withVehicleKeys(SineWithDwellSettings::fields().describe())});
   registry.addAnalysis(
       "iso3888_2", [](const ParamReader& r) { return std::make_unique<Iso3888Analysis>(r); },
       {"ISO 3888-2 double lane change (obstacle avoidance): the cone layout from the vehicle width, the scene run "

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <limits>
 
@@ -179,8 +180,8 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
     const RunSummary seg = simulate(*v.scene, s, sim, &rec, [&](const SimTK::State& st) {
       const double beta = v.scene->evalOutput("chassis.side_slip_rad", st);
       if (std::abs(beta) > spinLimit)
-        throw Error("'" + v.name + "' spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
-                    formatValue(beta * 180 / SimTK::Pi) + " deg beyond " + formatValue(spinLimit * 180 / SimTK::Pi) +
+        throw Error("'" + v.name + "' spun out at t = " + formatSig(st.getTime()) + " s (side slip " +
+                    formatSig(beta * 180 / SimTK::Pi, 3) + " deg beyond " + formatSig(spinLimit * 180 / SimTK::Pi, 3) +
                     " deg)");
     });
     // The integrator may stop a rounding short of te; the next segment must
@@ -206,6 +207,12 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
   h.side_slip_rad = rec.column("chassis.side_slip_rad");
   h.roll_rad = rec.column("chassis.roll_rad");
   return h;
+}
+
+std::string formatSig(double v, int digits) {
+  char b[64];
+  std::snprintf(b, sizeof b, "%.*g", digits, v);
+  return b;
 }
 
 double interpolate(const std::vector<double>& t, const std::vector<double>& y, double at) {

@@ -24,6 +24,7 @@ Iso3888Layout Iso3888Layout::make(double b, double x1) {
   Iso3888Layout L;
   L.vehicle_width_m = b;
   L.entry_x_m = x1;
+  // ISO 3888-2:2011 Table 1 (docs/iso3888_2_layout.md): lane widths of sections 1, 3, 5.
   const double w1 = 1.1 * b + 0.25, w3 = b + 1.0, w5 = std::max(1.3 * b + 0.25, 3.0);
   const double* len = L.section_length_m;
   const double x2 = x1 + len[0], x3 = x2 + len[1], x4 = x3 + len[2], x5 = x4 + len[3], xEnd = x5 + len[4];

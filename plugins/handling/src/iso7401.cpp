@@ -50,15 +50,21 @@ void StepSteerSettings::validate() const {
     throw Error("step steer duration_s (" + formatValue(duration_s) + ") must exceed twice ramp_time_s");
 }
 
+const FieldTable<StepSteerSettings>& StepSteerSettings::fields() {
+  static const FieldTable<StepSteerSettings> t = [] {
+    FieldTable<StepSteerSettings> f;
+    addTransientTestKeys(f, "test speed (ISO 7401: 80 km/h)", "steady lateral acceleration the step aims at")
+        .number("step_start_s", &StepSteerSettings::step_start_s, "s", "start of the steering ramp")
+        .number("ramp_time_s", &StepSteerSettings::ramp_time_s, "s", "ramp duration (smooth step 7.4)")
+        .number("duration_s", &StepSteerSettings::duration_s, "s", "simulated time after the ramp starts");
+    return f;
+  }();
+  return t;
+}
+
 StepSteerSettings StepSteerSettings::fromParams(const ParamReader& r) {
   StepSteerSettings s;
-  s.speed_m_s = r.numberOr("speed_m_s", s.speed_m_s);
-  s.lateral_accel_m_s2 = r.numberOr("lateral_accel_m_s2", s.lateral_accel_m_s2);
-  s.step_start_s = r.numberOr("step_start_s", s.step_start_s);
-  s.ramp_time_s = r.numberOr("ramp_time_s", s.ramp_time_s);
-  s.duration_s = r.numberOr("duration_s", s.duration_s);
-  s.sample_s = r.numberOr("sample_s", s.sample_s);
-  if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+  fields().read(r, s);
   s.validate();
   return s;
 }

@@ -18,23 +18,108 @@ void SineWithDwellSettings::validate() const {
   requirePositive(sample_s, "sine with dwell sample_s");
 }
 
+const FieldTable<SineWithDwellSettings>& SineWithDwellSettings::fields() {
+  using S = SineWithDwellSettings;
+  static const FieldTable<S> t = [] {
+    FieldTable<S> f;
+    addTransientTestKeys(f, "entry speed (80 km/h; held up to the beginning of steer)",
+                         "steady lateral acceleration defining A (0.3 g)")
+        .number("frequency_Hz", &S::frequency_Hz, "Hz", "sine frequency")
+        .number("dwell_s", &S::dwell_s, "s", "dwell at the second peak")
+        .number("start_s", &S::start_s, "s", "beginning of steer (BOS)")
+        .number("after_s", &S::after_s, "s", "simulated time after the completion of steer (>= 1.75)")
+        .number("first_factor", &S::first_factor, "", "first amplitude / A")
+        .number("factor_step", &S::factor_step, "", "amplitude increment / A")
+        .number("max_amplitude_factor", &S::max_amplitude_factor, "", "last amplitude / A")
+        .number("max_amplitude_rad", &S::max_amplitude_rad, "rad", "cap on the road-wheel amplitude")
+        .boolean("coast", &S::coast, "coast from the beginning of steer (false: speed held)");
+    return f;
+  }();
+  return t;
+}
+
 SineWithDwellSettings SineWithDwellSettings::fromParams(const ParamReader& r) {
   SineWithDwellSettings s;
-  s.speed_m_s = r.numberOr("speed_m_s", s.speed_m_s);
-  s.lateral_accel_m_s2 = r.numberOr("lateral_accel_m_s2", s.lateral_accel_m_s2);
-  s.frequency_Hz = r.numberOr("frequency_Hz", s.frequency_Hz);
-  s.dwell_s = r.numberOr("dwell_s", s.dwell_s);
-  s.start_s = r.numberOr("start_s", s.start_s);
-  s.after_s = r.numberOr("after_s", s.after_s);
-  s.first_factor = r.numberOr("first_factor", s.first_factor);
-  s.factor_step = r.numberOr("factor_step", s.factor_step);
-  s.max_amplitude_factor = r.numberOr("max_amplitude_factor", s.max_amplitude_factor);
-  s.max_amplitude_rad = r.numberOr("max_amplitude_rad", s.max_amplitude_rad);
-  s.sample_s = r.numberOr("sample_s", s.sample_s);
-  s.coast = r.booleanOr("coast", s.coast);
-  if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+  fields().read(r, s);
   s.validate();
   return s;
+}
+
+void evaluateSineWithDwellRun(const HandlingHistory& h, const SineWithDwellTimes& tm, const SineWithDwellSettings& set,
+                              SineWithDwellRun& run) {
+  const std::vector<double>& t = h.t_s;
+  const std::vector<double>& r = h.yaw_rate_rad_s;
+  if (t.empty() || t.back() < tm.cos_s + 1.75 - 1e-9)
+    throw Error("sine with dwell: the history ends at " + formatValue(t.empty() ? 0.0 : t.back()) +
+                " s, before COS + 1.75 s = " + formatValue(tm.cos_s + 1.75) + " s");
+  run.completed = false;
+  run.spun_out = false;
+  run.pass = false;
+  const double sg = -tm.first_steer_sign;  // sign of the yaw rate the reversal produces
+  const double tSample1 = tm.cos_s + 1.0, tSample175 = tm.cos_s + 1.75;
+  // The first local peak of sg * r after the reversal: the largest value since
+  // the last time the yaw rate turned toward sg, confirmed once it has fallen
+  // back by 1 % of itself. An extreme at the anchor (the yaw rate already
+  // retreating there: the first lobe's motion) is not a peak; the anchor moves on.
+  std::size_t i = 0;
+  while (i < t.size() && t[i] < tm.reversal_s) ++i;
+  std::size_t anchor = i, im = i;
+  bool found = false;
+  for (; i < t.size() && t[i] <= tSample1; ++i) {
+    const double y = sg * r[i];
+    if (y > sg * r[im]) {
+      im = i;
+    } else if (sg * r[im] - y > 0.01 * std::abs(r[im]) + 1e-9) {
+      if (im > anchor) {
+        found = true;
+        break;
+      }
+      anchor = im = i;
+    }
+  }
+  if (!found) {
+    run.spun_out = true;
+    run.reason = "spun out: the yaw rate after the steering reversal has no peak up to COS + 1.0 s (" +
+                 formatSig(interpolate(t, r, tSample1)) + " rad/s there, still growing)";
+    return;
+  }
+  const double pk = r[im];
+  if (!(sg * pk > 0)) {
+    run.reason = "the yaw rate did not take the reversal's sign (its first peak after the reversal is " +
+                 formatSig(pk) + " rad/s)";
+    return;
+  }
+  // With the steering centred (from COS) a recovering vehicle's yaw rate
+  // stays below that peak. (While steered, a saturated vehicle's yaw rate may
+  // wiggle past its first peak: that is no spin.)
+  for (std::size_t k = im + 1; k < t.size(); ++k)
+    if (t[k] >= tm.cos_s && std::abs(r[k]) > std::abs(pk)) {
+      run.spun_out = true;
+      run.reason = "spun out: the yaw rate " + formatSig(r[k]) + " rad/s at t = " + formatSig(t[k]) +
+                   " s exceeds its peak after the steering reversal (" + formatSig(pk) + " rad/s at " +
+                   formatSig(t[im]) + " s)";
+      return;
+    }
+  // Nor does it turn back into the spin: a yaw rate that grows again after the
+  // second ratio sample and ends above half the peak (a slow spin that has not
+  // passed the peak before the run ends).
+  const double rS = interpolate(t, r, tSample175), rE = r.back();
+  if (t.back() > tSample175 && sg * rE > sg * rS && sg * rE > 0.5 * std::abs(pk)) {
+    run.spun_out = true;
+    run.reason = "spun out: with the steering centred the yaw rate grows again, from " + formatSig(rS) +
+                 " rad/s at COS + 1.75 s to " + formatSig(rE) + " rad/s at " + formatSig(t.back()) + " s (peak " +
+                 formatSig(pk) + " rad/s)";
+    return;
+  }
+  run.completed = true;
+  run.peak_yaw_rate_rad_s = pk;
+  run.peak_time_s = t[im];
+  run.yaw_ratio_1s = interpolate(t, r, tSample1) / pk;
+  run.yaw_ratio_175 = interpolate(t, r, tSample175) / pk;
+  run.lateral_displacement_m =
+      tm.first_steer_sign * (interpolate(t, h.y_m, tm.bos_s + 1.07) - interpolate(t, h.y_m, tm.bos_s));
+  run.pass = run.yaw_ratio_1s <= set.yaw_ratio_1s_limit && run.yaw_ratio_175 <= set.yaw_ratio_175_limit &&
+             (run.factor < set.displacement_from_factor - 1e-9 || run.lateral_displacement_m >= set.displacement_limit_m);
 }
 
 SineWithDwellResult runSineWithDwell(const HandlingVehicle& v, const SineWithDwellSettings& set) {
@@ -70,21 +155,12 @@ SineWithDwellResult runSineWithDwell(const HandlingVehicle& v, const SineWithDwe
       run.reason = e.what();
     }
     if (run.completed) {
-      const auto& h = run.history;
-      // First yaw-rate peak after the steering changes sign (t0 + T/2): the
-      // extreme of the negative lobe up to COS + 1 s.
-      double pk = 0;
-      for (std::size_t i = 0; i < h.t_s.size(); ++i)
-        if (h.t_s[i] >= t0 + 0.5 * T && h.t_s[i] <= tCos + 1.0) pk = std::min(pk, h.yaw_rate_rad_s[i]);
-      run.peak_yaw_rate_rad_s = pk;
-      const double r1 = interpolate(h.t_s, h.yaw_rate_rad_s, tCos + 1.0);
-      const double r175 = interpolate(h.t_s, h.yaw_rate_rad_s, tCos + 1.75);
-      run.yaw_ratio_1s = pk != 0 ? r1 / pk : 0;
-      run.yaw_ratio_175 = pk != 0 ? r175 / pk : 0;
-      run.lateral_displacement_m =
-          interpolate(h.t_s, h.y_m, t0 + 1.07) - interpolate(h.t_s, h.y_m, t0);
-      run.pass = run.yaw_ratio_1s <= set.yaw_ratio_1s_limit && run.yaw_ratio_175 <= set.yaw_ratio_175_limit &&
-                 (k < set.displacement_from_factor - 1e-9 || run.lateral_displacement_m >= set.displacement_limit_m);
+      SineWithDwellTimes times;
+      times.bos_s = t0, times.reversal_s = t0 + 0.5 * T, times.cos_s = tCos;
+      times.first_steer_sign = A >= 0 ? 1 : -1;
+      evaluateSineWithDwellRun(run.history, times, set, run);
+    } else {
+      run.spun_out = run.reason.find("spun out") != std::string::npos;
     }
     out.pass = out.pass && run.pass;
     out.runs.push_back(std::move(run));

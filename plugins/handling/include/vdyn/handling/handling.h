@@ -20,6 +20,7 @@
 
 #include <Simbody.h>
 
+#include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 #include "vdyn/core/scene.h"
 #include "vdyn/core/simulation.h"
@@ -131,6 +132,26 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double speed_m_s,
                                      const IntegratorSettings& integrator, double spin_limit_rad = 0.5,
                                      RunSummary* summary = nullptr, const std::vector<double>& restarts_s = {},
                                      double coast_from_s = 1e300, const SimTK::State* start = nullptr);
+
+/// The keys every transient handling test's settings share (ISO 7401 step
+/// steer, sine with dwell): speed_m_s, lateral_accel_m_s2, sample_s and the
+/// integrator object; T has members of those names. One place for their
+/// units and meanings, in each test's field table.
+template <class T>
+FieldTable<T>& addTransientTestKeys(FieldTable<T>& t, const char* speedMeaning, const char* lateralMeaning) {
+  return t.number("speed_m_s", &T::speed_m_s, "m/s", speedMeaning)
+      .number("lateral_accel_m_s2", &T::lateral_accel_m_s2, "m/s^2", lateralMeaning)
+      .number("sample_s", &T::sample_s, "s", "sampling interval of the recorded response")
+      .custom("integrator", "-", "{\"method\": \"rk_merson\", \"accuracy\": 1e-6}",
+              "integrator settings {method, accuracy, ...}",
+              [](const ParamReader& r, T& s) {
+                if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+              });
+}
+
+/// `digits` significant digits (printf %g) for reports and run messages
+/// (formatValue's round-trip 17 digits are for echoing user input).
+std::string formatSig(double v, int digits = 4);
 
 /// Linear interpolation of y(t) at t (clamped).
 double interpolate(const std::vector<double>& t, const std::vector<double>& y, double at);

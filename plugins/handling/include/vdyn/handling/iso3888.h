@@ -5,16 +5,18 @@
 // strikes of the vehicle body and the highest entry speed that passes, found
 // by bisection.
 //
-// Layout (ISO 3888-2:2011, Table 1; b = vehicle width, m), along the ground X
-// axis from the entry of section 1 at X1:
+// Layout (ISO 3888-2:2011, clause 4.1 and Table 1; b = vehicle width, m; the
+// table, its sources and what was checked against them: docs/iso3888_2_layout.md),
+// along the ground X axis from the entry of section 1 at X1 (lane limits are
+// the lines tangent to the cones' bases, clause 4.2):
 //   section 1  entry lane     length 12   m, width 1.1 b + 0.25
 //   section 2  transition     length 13.5 m (no cones beside it)
 //   section 3  side lane      length 11   m, width b + 1, shifted to the LEFT:
 //              its right cone line 1 m left of section 1's left cone line
 //   section 4  transition     length 12.5 m
-//   section 5  exit lane      length 12   m, width 1.3 b + 0.25, at least 3 m;
-//              its right cone line on section 1's right cone line
-// 61 m in all. Y = 0 is section 1's centre line (the vehicle starts on it).
+//   section 5  exit lane      length 12   m, width 1.3 b + 0.25, at least 3 m
+//              (3 m for b < 2.115 m); its right cone line on section 1's right one
+// 61 m in all (clause 4.1). Y = 0 is section 1's centre line (the vehicle starts on it).
 //
 // Cone strikes: each lane section's two cone lines are segments
 // [X_start, X_end] at constant Y. The vehicle body is the rectangle

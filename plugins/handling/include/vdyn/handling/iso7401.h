@@ -12,8 +12,11 @@ namespace vdyn {
 
 struct StepSteerSettings {
   /// Keys speed_m_s, lateral_accel_m_s2, step_start_s, ramp_time_s,
-  /// duration_s, sample_s, integrator {method, accuracy, ...} (optional).
+  /// duration_s, sample_s, integrator {method, accuracy, ...} (all optional):
+  /// fields(), then validate().
   static StepSteerSettings fromParams(const ParamReader& r);
+  /// The key table (reading, `vdyn list`).
+  static const FieldTable<StepSteerSettings>& fields();
 
   double speed_m_s = 80.0 / 3.6;      ///< test speed, m/s (ISO 7401: 80 km/h)
   double lateral_accel_m_s2 = 4.0;    ///< steady a_y the step aims at, m/s^2 (ISO: 4)

@@ -12,7 +12,9 @@
 // from 5 A). As the procedure: the speed is held (3.18) up to the beginning of
 // steer and the vehicle coasts from there (`coast`, default true); the sine
 // starts and ends with its full rate (no blend): the integrator restarts at
-// both kinks (runHandlingTransient's restarts).
+// both kinks (runHandlingTransient's restarts). A run whose vehicle does not
+// recover (evaluateSineWithDwellRun) is reported as spun out, with no ratios,
+// and fails the test.
 #include <string>
 #include <vector>
 
@@ -23,8 +25,11 @@ namespace vdyn {
 struct SineWithDwellSettings {
   /// Keys as the fields (speed_m_s, lateral_accel_m_s2, frequency_Hz, dwell_s,
   /// start_s, after_s, first_factor, factor_step, max_amplitude_factor,
-  /// max_amplitude_rad, sample_s, coast, integrator), each optional.
+  /// max_amplitude_rad, sample_s, coast, integrator), each optional:
+  /// fields(), then validate().
   static SineWithDwellSettings fromParams(const ParamReader& r);
+  /// The key table (reading, `vdyn list`).
+  static const FieldTable<SineWithDwellSettings>& fields();
 
   double speed_m_s = 80.0 / 3.6;      ///< m/s (80 km/h)
   double lateral_accel_m_s2 = 0.3 * 9.81;  ///< a_y defining A, m/s^2 (0.3 g)
@@ -50,10 +55,19 @@ struct SineWithDwellSettings {
 
 struct SineWithDwellRun {
   double factor = 0, amplitude_rad = 0;
-  bool completed = false;            ///< false: spin-out or failed run (reason)
+  /// true: the metrics below are the run's; false: no number is reported
+  /// (spun_out, or a failed run), `reason` says why.
+  bool completed = false;
+  /// The vehicle did not recover: its side slip passed the spin limit, or the
+  /// yaw rate after the steering reversal had no peak before COS + 1.0 s, or
+  /// with the steering centred (after COS) it grew beyond that peak, or grew
+  /// again after COS + 1.75 s to end the run above half the peak.
+  bool spun_out = false;
   std::string reason;
-  double peak_yaw_rate_rad_s = 0;    ///< first peak after the steering changes sign
-  double yaw_ratio_1s = 0, yaw_ratio_175 = 0;  ///< yaw rate at COS + 1.0 / 1.75 s over the peak
+  /// First local peak of the yaw rate after the steering changes sign (the
+  /// regulation's psi_dot_Peak; sign opposite to the first steer), rad/s, and its time, s.
+  double peak_yaw_rate_rad_s = 0, peak_time_s = 0;
+  double yaw_ratio_1s = 0, yaw_ratio_175 = 0;  ///< yaw rate at COS + 1.0 / 1.75 s over the peak, 1
   double lateral_displacement_m = 0;  ///< at BOS + 1.07 s, + toward the first steer
   bool pass = false;
   HandlingHistory history;
@@ -62,8 +76,27 @@ struct SineWithDwellRun {
 struct SineWithDwellResult {
   double angle_A_rad = 0;            ///< front angle at lateral_accel_m_s2 (steady state)
   std::vector<SineWithDwellRun> runs;
-  bool pass = false;                 ///< every run within the limits
+  bool pass = false;                 ///< every run completed and within the limits
 };
+
+/// The instants of one run, s: beginning of steer (BOS), the steering's sign
+/// change (BOS + T/2) and the completion of steer (COS = BOS + T + dwell).
+struct SineWithDwellTimes {
+  double bos_s = 0, reversal_s = 0, cos_s = 0;
+  double first_steer_sign = 1;  ///< sign of the first lobe's angle (+1: left first)
+};
+
+/// The metrics of one completed transient (FMVSS 126 S7.6-S7.7): finds the
+/// first local yaw-rate peak after the reversal (the yaw rate moving away
+/// from zero, then back by more than 1 % of the peak), the ratios at COS +
+/// 1.0 / 1.75 s and the displacement; sets completed = false and spun_out =
+/// true (no number) when there is no such peak before COS + 1.0 s or the yaw
+/// rate exceeds it in magnitude after COS or grows again after COS + 1.75 s
+/// to end above half of it, and completed = false when the yaw rate
+/// never takes the reversal's sign. pass against the settings' limits.
+/// The history must cover COS + 1.75 s.
+void evaluateSineWithDwellRun(const HandlingHistory& history, const SineWithDwellTimes& times,
+                              const SineWithDwellSettings& settings, SineWithDwellRun& run);
 
 SineWithDwellResult runSineWithDwell(const HandlingVehicle& vehicle, const SineWithDwellSettings& settings);
 
