@@ -88,6 +88,10 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
       sendUp(sweepJournalLine(d, runVariation(d, d.variations[std::size_t(index)], run)));
       ++res.ran;
     }
+    // Every rank leaves the sweep together: a worker that went on to a next
+    // sweep at once would send its hello while the manager still serves this
+    // one, which would hand it this sweep's variations and count it out twice.
+    MPI_Barrier(MPI_COMM_WORLD);
     res.workers = 1;
     res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     res.cpu_s = processCpuSeconds() - cpu0;
@@ -198,6 +202,7 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   }
   for (auto& t : pool) t.join();
   if (journal) std::fclose(journal);
+  MPI_Barrier(MPI_COMM_WORLD);  // every worker has had its -1; see the worker's barrier
   if (pendingCount == 0 && o.progress) o.progress(prog);
   res.workers = localThreads + size - 1;
   res.ran = prog.done;
