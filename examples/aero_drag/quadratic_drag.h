@@ -4,7 +4,7 @@
 //     F = -1/2 rho Cd A |v - w| (v - w)          (docs/equations.md, "Aerodynamic drag")
 // v the velocity of the point in ground, w the wind (ground frame), rho the air
 // density, Cd the drag coefficient, A the frontal area. Registered as the
-// force element "quadratic_drag" by vdyn_register_plugins (plugin.cpp).
+// force element "quadratic_drag" by vdyn_register_plugins (aero_drag_library.cpp).
 #include <string>
 
 #include <Simbody.h>

@@ -1,6 +1,6 @@
 #pragma once
 // The subcommands of the `vdyn` program (CONTRACTS.md item 4): one source file
-// each, listed in the table in main.cpp. A new subcommand is one more file and
+// each, listed in the table in vdyn_main.cpp. A new subcommand is one more file and
 // one more table line.
 #include <string>
 #include <vector>
@@ -34,7 +34,7 @@ int checkCommand(const std::vector<std::string>& args);
 int listCommand(const std::vector<std::string>& args);
 int sweepCommand(const std::vector<std::string>& args);
 
-/// The command table (main.cpp).
+/// The command table (vdyn_main.cpp).
 const std::vector<Command>& commands();
 const Command& command(const std::string& name);
 

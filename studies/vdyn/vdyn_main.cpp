@@ -3,7 +3,7 @@
 //   vdyn check SCENE [--set ...] [--plugin PATH ...]
 //   vdyn list [KIND] [--plugin PATH ...]
 //   vdyn sweep SWEEP [--threads N] [--out DIR] ...; mpirun -n N vdyn sweep SWEEP --mpi
-// One source file per subcommand (run.cpp, check.cpp, list.cpp, sweep.cpp), listed in the
+// One source file per subcommand (run_command.cpp, check_command.cpp, list_command.cpp, sweep_command.cpp), listed in the
 // table below.
 #include <cstdio>
 #include <iostream>
