@@ -78,12 +78,12 @@ TEST(Composition, Iso4138BodyForceAlongTheTravelLowersTheSpeedHoldForceByIt) {
   std::printf("beta %.6e rad; speed hold %.9f N plain, %.9f N pushed: difference %.9f N (F = %g N)\n", beta, h0, h1,
               h0 - h1, F);
   EXPECT_GT(h0, 0.0);  // the tires' drag in the turn
-  EXPECT_NEAR(h0 - h1, F, 1e-6 * F);
+  EXPECT_NEAR(h0 - h1, F, 1e-8 * F);  // measured: 8e-9 N of 3000 N
   EXPECT_NEAR(cell(t1, 0, "front_deg"), cell(t0, 0, "front_deg"), 1e-7);
   EXPECT_NEAR(cell(t1, 0, "side_slip_deg"), cell(t0, 0, "side_slip_deg"), 1e-7);
   // The summary says which plugins the analysis added to the scene's.
   EXPECT_EQ(pushed.summary.at("plugins").at("added").dump(),
-            R"(["front_steer (steering)","rear_steer (steering)","speed_hold (speed_hold)"])");
+            R"x(["front_steer (steering)","rear_steer (steering)","speed_hold (speed_hold)"])x");
   EXPECT_TRUE(pushed.summary.at("plugins").at("replaced").empty());
 }
 
@@ -98,7 +98,7 @@ TEST(Composition, Iso4138BodyForceAlongChassisXChangesTheTable) {
   const double d = cell(t0, 0, "speed_hold_force_N") - cell(t1, 0, "speed_hold_force_N");
   std::printf("chassis-x push: hold force difference %.6f N, front %.9f -> %.9f deg\n", d, cell(t0, 0, "front_deg"),
               cell(t1, 0, "front_deg"));
-  EXPECT_NEAR(d, F, 0.01 * F);
+  EXPECT_NEAR(d, F, 1e-3 * F);  // measured: 0.19 N less
   EXPECT_NE(cell(t0, 0, "front_deg"), cell(t1, 0, "front_deg"));
 }
 
@@ -110,7 +110,7 @@ TEST(Composition, HandlingAnalysisReplacesTheScenesSteeringAndSpeedHold) {
     {"type": "speed_hold", "name": "hold", "attach": "chassis", "speed_m_s": 30},
     {"type": "body_force", "name": "push", "attach": "chassis", "force_N": [0, 0, 0]}])"_json;
   const AnalysisResult a = runAnalysis(iso4138At10(plugins)), b = runAnalysis(iso4138At10(Json::array()));
-  EXPECT_EQ(a.summary.at("plugins").at("replaced").dump(), R"(["front_steer (steering)","hold (speed_hold)"])");
+  EXPECT_EQ(a.summary.at("plugins").at("replaced").dump(), R"x(["front_steer (steering)","hold (speed_hold)"])x");
   // A zero force changes nothing: the same numbers as the scene without plugins.
   EXPECT_EQ(cell(tableOf(a, "iso4138"), 0, "front_deg"), cell(tableOf(b, "iso4138"), 0, "front_deg"));
 }
@@ -176,8 +176,10 @@ TEST(Composition, LibraryTireInStability) {
   expectTireReaches(bicycleScene(R"({"type": "stability"})"_json));
 }
 TEST(Composition, LibraryTireInContinuation) {
-  expectTireReaches(bicycleScene(
-      R"({"type": "continuation", "plugin": "front_steer", "key": "angle_rad", "values": [0.01, 0.02]})"_json));
+  Json s = bicycleScene(
+      R"({"type": "continuation", "plugin": "front_steer", "key": "angle_rad", "values": [0.01, 0.02]})"_json);
+  s["outputs"] = {"chassis.yaw_rate_rad_s"};  // tabulated per point
+  expectTireReaches(s);
 }
 TEST(Composition, LibraryTireInSensitivity) {
   expectTireReaches(quarterCarScene(R"({"type": "sensitivity",
