@@ -17,6 +17,7 @@
 #include "study.h"
 #include "vdyn/handling/iso4138.h"
 #include "vdyn/vehicles/handling_vehicles.h"
+#include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
 
@@ -50,8 +51,11 @@ int main(int argc, char** argv) {
                                  opts);
     const std::string out = study::outputDir(vm, "benchmarks");
     const std::string load0 = loadavg();
-    LinearBicycleParams lin;
-    auto b = makeHandlingFourWs(FourWsParams::fromFile(vm["data"].as<std::string>()), "2ws", lin, nullptr);
+    // The vehicle as a scene (no plugins), prepared for the handling tests (2WS).
+    const Json scene = {{"name", "iso4138_cost"},
+                        {"vehicle", {{"type", "fourws"}, {"data", vm["data"].as<std::string>()}}},
+                        {"analysis", {{"type", "iso4138_constant_radius"}}}};
+    auto b = buildHandlingScene(SceneDescription::fromJson(scene, "", standardRegistry()), HandlingSetup{});
     const HandlingVehicle& v = b->vehicle;
     ConstantRadiusSettings set;
     set.radius_m = vm["radius-m"].as<double>();

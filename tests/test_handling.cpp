@@ -23,16 +23,20 @@ using namespace vdyn;
 namespace {
 const double kDeg = SimTK::Pi / 180;
 
-std::unique_ptr<HandlingBuild> bike(const std::string& tire) {
-  BicycleParams p = BicycleParams::fromFile("bicycle.json");
-  p.tire_plugin = tire;
-  return makeHandlingBicycle(p);
+/// The bicycle (bicycle.json with the tire plugin `tire`) as a scene prepared
+/// for the handling tests (buildHandlingScene: the analyses' composition).
+std::unique_ptr<HandlingScene> bike(const std::string& tire) {
+  const Json scene = {
+      {"name", "bike"},
+      {"vehicle", {{"type", "bicycle"}, {"data", "bicycle.json"}, {"overrides", {{"tire", {{"plugin", tire}}}}}}},
+      {"analysis", {{"type", "iso4138_constant_radius"}}}};
+  return buildHandlingScene(SceneDescription::fromJson(scene, "", standardRegistry()), HandlingSetup{});
 }
 }  // namespace
 
 TEST(Iso4138, LinearTireBicycleUndersteerGradientIsTheClosedForm) {
   auto b = bike("linear");
-  const Bicycle& bk = *b->bicycle;
+  const Bicycle& bk = b->built.vehicleAs<Bicycle>();
   ConstantRadiusSettings set;
   set.radius_m = 100;
   set.speed_start_m_s = 3;
@@ -138,7 +142,11 @@ TEST(Iso7401, GimTireFrequencyResponseAboutATurnMatchesSineSteerSimulations) {
 }
 
 TEST(VehicleReport, StaticLoadsBalanceTheWeightAndKinematicsAreConsistent) {
-  const VehicleReport r = makeFourWsReport(FourWsParams::fromFile("appendix_a.json"), {-0.08, 0.0, 0.08});
+  const Json scene = {{"name", "report"},
+                      {"vehicle", {{"type", "fourws"}, {"data", "appendix_a.json"}}},
+                      {"analysis", {{"type", "vehicle_report"}}}};
+  const VehicleReport r =
+      makeVehicleReport(SceneDescription::fromJson(scene, "", standardRegistry()), {-0.08, 0.0, 0.08});
   std::printf("4ws: loads %.2f %.2f %.2f %.2f N (sum %.3f, weight %.3f), c.m. height %.4f m, %d iterations\n",
               r.corner_loads_N[0].second, r.corner_loads_N[1].second, r.corner_loads_N[2].second,
               r.corner_loads_N[3].second, r.total_load_N, r.weight_N, r.com_height_m, r.iterations);

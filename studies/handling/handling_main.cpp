@@ -31,17 +31,21 @@ std::string sig(double v, int digits = 4, const char* missing = "-") {
 
 struct Config {
   ParamReader data;
-  FourWsParams fourws;
-  BicycleParams bicycle;
-  LinearBicycleParams linear;
-  KrTable table;
-  double tire_width_m;
+  std::string fourws_data, bicycle_data;  ///< vehicle data files
+  HandlingSetup setup;                    ///< kr_table, linear_bicycle, tire_width_m (rear_strategy per vehicle)
 };
 
-std::unique_ptr<HandlingBuild> build(const Config& c, const std::string& vehicle) {
-  if (vehicle == "bicycle") return makeHandlingBicycle(c.bicycle, c.tire_width_m);
-  const std::string strategy = vehicle.substr(4);  // "4ws/<strategy>"
-  return makeHandlingFourWs(c.fourws, strategy, c.linear, &c.table, c.tire_width_m);
+/// The vehicle ("bicycle" or "4ws/<strategy>") as a scene (the vehicle from
+/// its data file, no plugins) prepared for the handling tests: the one
+/// composition path of the scene files' handling analyses.
+std::unique_ptr<HandlingScene> build(const Config& c, const std::string& vehicle) {
+  const bool bike = vehicle == "bicycle";
+  HandlingSetup setup = c.setup;
+  if (!bike) setup.rear_strategy = vehicle.substr(4);  // "4ws/<strategy>"
+  const Json scene = {{"name", "handling"},
+                      {"vehicle", {{"type", bike ? "bicycle" : "fourws"}, {"data", bike ? c.bicycle_data : c.fourws_data}}},
+                      {"analysis", {{"type", "iso4138_constant_radius"}}}};
+  return buildHandlingScene(SceneDescription::fromJson(scene, "", standardRegistry()), setup);
 }
 
 std::string fileTag(const std::string& vehicle) {
@@ -430,12 +434,12 @@ int main(int argc, char** argv) {
         "no-plots", "skip the PNG plots");
     const auto vm = study::parse("handling", "standard handling tests (ISO 4138, ISO 7401, sine with dwell)", argc,
                                  argv, opts);
-    Config c{ParamReader::fromFile(vm["data"].as<std::string>()), {}, {}, {}, {}, 0};
-    c.fourws = FourWsParams::fromFile(c.data.string("vehicle_data"));
-    c.bicycle = BicycleParams::fromFile(c.data.string("bicycle_data"));
-    c.linear = LinearBicycleParams::fromParams(c.data.child("linear_bicycle"));
-    c.table = KrTable::fromFile(c.data.string("kr_table"));
-    c.tire_width_m = c.data.number("tire_width_m");
+    Config c{ParamReader::fromFile(vm["data"].as<std::string>()), {}, {}, {}};
+    c.fourws_data = c.data.string("vehicle_data");
+    c.bicycle_data = c.data.string("bicycle_data");
+    c.setup.linear = LinearBicycleParams::fromParams(c.data.child("linear_bicycle"));
+    c.setup.kr_table = c.data.string("kr_table");
+    c.setup.tire_width_m = c.data.number("tire_width_m");
     const auto tests = splitList(vm["test"].as<std::string>());
     const auto vehicles = splitList(vm["vehicle"].as<std::string>());
     for (const auto& t : tests)

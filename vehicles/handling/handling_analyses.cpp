@@ -1,11 +1,12 @@
 // The handling tests as analyses a scene file names ("analysis": {"type":
 // "iso4138_constant_radius" | "iso7401" | "sine_with_dwell" | "iso3888_2" |
-// "vehicle_report"}). iso3888_2 runs the scene itself (closed loop, its own
-// plugins); the others:
-// Each rebuilds the scene's vehicle (type and data file with its overrides)
-// prepared for the tests (handling_vehicles.h): programmable steering, speed
-// hold and the rear-steer strategy named in the settings. Plugins listed in the
-// scene are not used by these analyses (the test defines the steering).
+// "vehicle_report"}), each on the scene's built scene (its vehicle and every
+// plugin it lists, plugin-library types included). iso3888_2 runs the scene
+// itself (closed loop, its own plugins; the analysis sets the path controller's
+// path and the entry speed). The open-loop tests replace the scene's steering
+// constraints, speed holds and controllers with their own programmable
+// steering and speed hold (buildHandlingScene, handling_vehicles.h) and list
+// what they replaced and added in the summary key "plugins".
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -22,77 +23,68 @@ namespace vdyn {
 namespace {
 const double kDeg = SimTK::Pi / 180;
 
-/// Keys every handling analysis takes besides its test's own.
-struct VehicleChoice {
-  std::string rear_strategy = "2ws";
-  std::string kr_table = "kr_table.json";
-  LinearBicycleParams linear;
-  double tire_width_m = 0.195;
-  bool has_linear = false;
-  static VehicleChoice fromParams(const ParamReader& r) {
-    VehicleChoice c;
-    c.rear_strategy = r.stringOr("rear_strategy", c.rear_strategy);
-    c.kr_table = r.stringOr("kr_table", c.kr_table);
-    c.tire_width_m = r.numberOr("tire_width_m", c.tire_width_m);
-    if (r.has("linear_bicycle")) c.linear = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
-    const auto& names = rearSteerStrategyNames();
-    if (std::find(names.begin(), names.end(), c.rear_strategy) == names.end())
-      throw Error(r.at("rear_strategy") + ": unknown rear steer strategy '" + c.rear_strategy + "'; known: 2ws, linear, nonlinear");
-    return c;
+/// ISO 7401's frequency-response keys (one table: read and listed).
+struct FrequencyKeys {
+  double frequency_from_Hz = 0.1, frequency_to_Hz = 4.0;
+  int frequency_count = 25;
+  static const FieldTable<FrequencyKeys>& fields() {
+    using F = FrequencyKeys;
+    static const auto t = FieldTable<F>()
+                              .number("frequency_from_Hz", &F::frequency_from_Hz, "Hz", "lowest frequency")
+                              .number("frequency_to_Hz", &F::frequency_to_Hz, "Hz", "highest frequency")
+                              .integer("frequency_count", &F::frequency_count, "", "log-spaced frequencies");
+    return t;
   }
 };
-const std::vector<FieldInfo> kVehicleKeys = {
-    {"rear_strategy", "-", "\"2ws\"", "4WS rear steer: 2ws, linear (Kr(U) of linear_bicycle), nonlinear (kr_table)"},
-    {"kr_table", "-", "\"kr_table.json\"", "coefficient table of the nonlinear strategy"},
-    {"linear_bicycle", "-", "chapter 6 values", "linear bicycle of the linear strategy (mass_kg, ...)"},
-    {"tire_width_m", "m", "0.195", "tire section width (vehicle width = track + this)"}};
 
-ParamReader vehicleData(const SceneDescription& d) {
-  const Json& v = d.json().at("vehicle");
-  Json data = ParamReader::fromFile(d.resolve(v.at("data").get<std::string>())).json();
-  if (v.contains("overrides")) data.merge_patch(v.at("overrides"));
-  return ParamReader::fromJson(std::move(data), v.at("data").get<std::string>());
-}
-
-std::string vehicleType(const SceneDescription& d) { return d.json().at("vehicle").at("type").get<std::string>(); }
-
-std::unique_ptr<HandlingBuild> buildHandling(const SceneDescription& d, const VehicleChoice& c) {
-  const std::string type = vehicleType(d);
-  if (type == "bicycle") return makeHandlingBicycle(BicycleParams::fromParams(vehicleData(d)), c.tire_width_m);
-  if (type == "fourws") {
-    KrTable table;
-    const bool needTable = c.rear_strategy == "nonlinear";
-    if (needTable) table = KrTable::fromFile(d.resolve(c.kr_table));
-    return makeHandlingFourWs(FourWsParams::fromParams(vehicleData(d)), c.rear_strategy, c.linear,
-                              needTable ? &table : nullptr, c.tire_width_m);
+/// vehicle_report's keys.
+struct TravelKeys {
+  double travel_range_m = 0.08, travel_step_m = 0.01;
+  static const FieldTable<TravelKeys>& fields() {
+    using T = TravelKeys;
+    static const auto t = FieldTable<T>()
+                              .number("travel_range_m", &T::travel_range_m, "m", "wheel travel +- this")
+                              .number("travel_step_m", &T::travel_step_m, "m", "travel step");
+    return t;
   }
-  throw Error("handling tests run on vehicle types fourws and bicycle, not '" + type + "'");
-}
+};
+
+/// iso3888_2's key besides Iso3888Settings'.
+struct Iso3888Keys {
+  double tire_width_m = 0.195;
+  static const FieldTable<Iso3888Keys>& fields() {
+    static const auto t = FieldTable<Iso3888Keys>().number(
+        "tire_width_m", &Iso3888Keys::tire_width_m, "m", "tire section width (vehicle width = track + this)");
+    return t;
+  }
+};
 
 Json nullIfNan(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
 class ConstantRadiusAnalysis : public Analysis {
  public:
   explicit ConstantRadiusAnalysis(const ParamReader& r)
-      : Analysis("iso4138_constant_radius"), c_(VehicleChoice::fromParams(r)) {
+      : Analysis("iso4138_constant_radius"), c_(HandlingSetup::fromParams(r)) {
     s_ = ConstantRadiusSettings::fromParams(r);
   }
 
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
-    auto b = buildHandling(ctx.description, c_);
+    auto b = buildHandlingScene(ctx.description, c_);
     const ConstantRadiusResult r = runConstantRadius(b->vehicle, s_);
     AnalysisResult res;
     Table t;
     t.columns = {"speed_m_s", "lateral_accel_m_s2", "front_deg", "rear_deg", "side_slip_deg", "roll_deg",
                  "yaw_rate_rad_s", "understeer_gradient_deg_per_m_s2", "delta_minus_l_over_R_deg", "stable",
-                 "least_damped_re_per_s"};
+                 "least_damped_re_per_s", "speed_hold_force_N"};
     for (const auto& p : r.points)
       t.rows.push_back({p.speed_m_s, p.lateral_accel_m_s2, p.front_rad / kDeg, p.rear_rad / kDeg, p.side_slip_rad / kDeg,
                         p.roll_rad / kDeg, p.yaw_rate_rad_s, p.understeer_gradient_rad_per_m_s2 / kDeg,
-                        (p.front_rad - r.wheelbase_m / r.radius_m) / kDeg, double(p.stable), p.least_damped.real()});
+                        (p.front_rad - r.wheelbase_m / r.radius_m) / kDeg, double(p.stable), p.least_damped.real(),
+                        p.speed_hold_force_N});
     res.tables.push_back({"iso4138", t});
     res.summary = {{"vehicle", b->vehicle.name},
+                   {"plugins", b->describePlugins()},
                    {"radius_m", r.radius_m},
                    {"points", r.points.size()},
                    {"limit_found", r.limit_found},
@@ -107,23 +99,22 @@ class ConstantRadiusAnalysis : public Analysis {
   }
 
  private:
-  VehicleChoice c_;
+  HandlingSetup c_;
   ConstantRadiusSettings s_;
 };
 
 class Iso7401Analysis : public Analysis {
  public:
-  explicit Iso7401Analysis(const ParamReader& r) : Analysis("iso7401"), c_(VehicleChoice::fromParams(r)) {
+  explicit Iso7401Analysis(const ParamReader& r) : Analysis("iso7401"), c_(HandlingSetup::fromParams(r)) {
     s_ = StepSteerSettings::fromParams(r);
-    f0_ = r.numberOr("frequency_from_Hz", 0.1);
-    f1_ = r.numberOr("frequency_to_Hz", 4.0);
-    n_ = int(r.numberOr("frequency_count", 25));
+    const FrequencyKeys k = FrequencyKeys::fields().read(r);
+    f0_ = k.frequency_from_Hz, f1_ = k.frequency_to_Hz, n_ = k.frequency_count;
     logFrequencies(f0_, f1_, n_);
   }
 
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
-    auto b = buildHandling(ctx.description, c_);
+    auto b = buildHandlingScene(ctx.description, c_);
     const StepSteerResult st = runStepSteer(b->vehicle, s_);
     const FrequencyResponseResult fr = calcSteeringFrequencyResponse(b->vehicle, s_.speed_m_s, logFrequencies(f0_, f1_, n_));
     AnalysisResult res;
@@ -139,6 +130,7 @@ class Iso7401Analysis : public Analysis {
     res.tables.push_back({"step_steer", step});
     res.tables.push_back({"frequency_response", f});
     res.summary = {{"vehicle", b->vehicle.name},
+                   {"plugins", b->describePlugins()},
                    {"front_deg", st.front_rad / kDeg},
                    {"steady_yaw_rate_rad_s", st.steady_yaw_rate_rad_s},
                    {"yaw_rate_gain_1_per_s", st.yaw_rate_gain_1_per_s},
@@ -153,7 +145,7 @@ class Iso7401Analysis : public Analysis {
   }
 
  private:
-  VehicleChoice c_;
+  HandlingSetup c_;
   StepSteerSettings s_;
   double f0_, f1_;
   int n_;
@@ -162,11 +154,11 @@ class Iso7401Analysis : public Analysis {
 class SineWithDwellAnalysis : public Analysis {
  public:
   explicit SineWithDwellAnalysis(const ParamReader& r)
-      : Analysis("sine_with_dwell"), c_(VehicleChoice::fromParams(r)), s_(SineWithDwellSettings::fromParams(r)) {}
+      : Analysis("sine_with_dwell"), c_(HandlingSetup::fromParams(r)), s_(SineWithDwellSettings::fromParams(r)) {}
 
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
-    auto b = buildHandling(ctx.description, c_);
+    auto b = buildHandlingScene(ctx.description, c_);
     const SineWithDwellResult r = runSineWithDwell(b->vehicle, s_);
     AnalysisResult res;
     Table t;
@@ -183,22 +175,14 @@ class SineWithDwellAnalysis : public Analysis {
       runs.push_back(j);
     }
     res.tables.push_back({"sine_with_dwell", t});
-    res.summary = {{"vehicle", b->vehicle.name}, {"angle_A_deg", r.angle_A_rad / kDeg}, {"pass", r.pass}, {"runs", runs}};
+    res.summary = {{"vehicle", b->vehicle.name}, {"plugins", b->describePlugins()}, {"angle_A_deg", r.angle_A_rad / kDeg}, {"pass", r.pass}, {"runs", runs}};
     return res;
   }
 
  private:
-  VehicleChoice c_;
+  HandlingSetup c_;
   SineWithDwellSettings s_;
 };
-
-/// The vehicle's footprint from the scene's vehicle type and data (width:
-/// widest track + tire_width_m; axle positions along the chassis x axis).
-VehicleFootprint footprintOf(const SceneDescription& d, double tireWidth) {
-  VehicleChoice c;
-  c.tire_width_m = tireWidth;
-  return buildHandling(d, c)->footprint;
-}
 
 Table runTrajectoryTable(const Iso3888Run& q) {
   Table t;
@@ -224,14 +208,14 @@ Table cornerTable(const Iso3888Run& q, const BodyOutline& body) {
 class Iso3888Analysis : public Analysis {
  public:
   explicit Iso3888Analysis(const ParamReader& r) : Analysis("iso3888_2"), s_(Iso3888Settings::fromParams(r)) {
-    tire_width_m_ = r.numberOr("tire_width_m", 0.195);
+    tire_width_m_ = Iso3888Keys::fields().read(r).tire_width_m;
     requirePositive(tire_width_m_, r.at("tire_width_m"));
   }
 
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
     const auto t0 = std::chrono::steady_clock::now();
-    const VehicleFootprint fp = footprintOf(ctx.description, tire_width_m_);
+    const VehicleFootprint fp = calcVehicleFootprint(*ctx.built.vehicle, tire_width_m_);
     const Iso3888Result r = findHighestPassingSpeed(ctx.description, s_, fp);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     AnalysisResult res;
@@ -324,8 +308,8 @@ class Iso3888Analysis : public Analysis {
 class VehicleReportAnalysis : public Analysis {
  public:
   explicit VehicleReportAnalysis(const ParamReader& r) : Analysis("vehicle_report") {
-    range_ = r.numberOr("travel_range_m", 0.08);
-    step_ = r.numberOr("travel_step_m", 0.01);
+    const TravelKeys k = TravelKeys::fields().read(r);
+    range_ = k.travel_range_m, step_ = k.travel_step_m;
     requirePositive(range_, r.at("travel_range_m"));
     requirePositive(step_, r.at("travel_step_m"));
   }
@@ -334,14 +318,7 @@ class VehicleReportAnalysis : public Analysis {
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
     std::vector<double> travels;
     for (double z = -range_; z <= range_ + 1e-12; z += step_) travels.push_back(std::abs(z) < 1e-12 ? 0.0 : z);
-    const std::string type = vehicleType(ctx.description);
-    VehicleReport rep;
-    if (type == "fourws")
-      rep = makeFourWsReport(FourWsParams::fromParams(vehicleData(ctx.description)), travels);
-    else if (type == "quarter_car")
-      rep = makeQuarterCarReport(QuarterCarParams::fromParams(vehicleData(ctx.description)), travels);
-    else
-      throw Error("vehicle_report runs on vehicle types fourws and quarter_car, not '" + type + "'");
+    const VehicleReport rep = makeVehicleReport(ctx.description, travels);
     AnalysisResult res;
     Json loads = Json::object();
     for (const auto& [n, f] : rep.corner_loads_N) loads[n] = f;
@@ -355,6 +332,8 @@ class VehicleReportAnalysis : public Analysis {
                    {"weight_N", rep.weight_N},
                    {"chassis_origin_height_m", rep.chassis_origin_height_m},
                    {"com_height_m", rep.com_height_m}};
+    if (!rep.added_plugins.empty() || !rep.replaced_plugins.empty())
+      res.summary["plugins"] = {{"replaced", rep.replaced_plugins}, {"added", rep.added_plugins}};
     for (const auto& [axle, pts] : rep.kinematics) {
       Table t;
       t.columns = {"travel_m", "camber_deg", "toe_in_deg", "track_change_m", "recession_m", "wheel_rate_N_per_m",
@@ -382,7 +361,8 @@ std::vector<FieldInfo> concat(std::vector<FieldInfo> a, const std::vector<FieldI
 }
 
 std::vector<FieldInfo> withVehicleKeys(std::vector<FieldInfo> f) {
-  f.insert(f.end(), kVehicleKeys.begin(), kVehicleKeys.end());
+  const auto keys = HandlingSetup::fields().describe();
+  f.insert(f.end(), keys.begin(), keys.end());
   return f;
 }
 }  // namespace
@@ -392,20 +372,13 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
       "iso4138_constant_radius", [](const ParamReader& r) { return std::make_unique<ConstantRadiusAnalysis>(r); },
       {"ISO 4138 steady-state circular driving, constant radius: steady-state solves (steering angle unknown, U = r R) "
        "continued in speed to the limit; table iso4138.csv",
-       withVehicleKeys({{"radius_m", "m", "100", "path radius of the chassis origin"},
-                        {"speed_start_m_s", "m/s", "4", "first speed"},
-                        {"speed_step_m_s", "m/s", "1", "speed increment"},
-                        {"speed_max_m_s", "m/s", "60", "last speed tried"},
-                        {"limit_tolerance_m_s", "m/s", "0.005", "bisection tolerance of the limit speed"},
-                        {"stability", "-", "true", "eigenvalues at each point"}})});
+       withVehicleKeys(ConstantRadiusSettings::fields().describe())});
   registry.addAnalysis(
       "iso7401", [](const ParamReader& r) { return std::make_unique<Iso7401Analysis>(r); },
       {"ISO 7401 step steer (simulation) and frequency response (linearisation about straight running); tables "
        "step_steer.csv, frequency_response.csv",
        withVehicleKeys(concat(StepSteerSettings::fields().describe(),
-                              {{"frequency_from_Hz", "Hz", "0.1", "lowest frequency"},
-                               {"frequency_to_Hz", "Hz", "4", "highest frequency"},
-                               {"frequency_count", "", "25", "log-spaced frequencies"}}))});
+                              FrequencyKeys::fields().describe()))});
   registry.addAnalysis(
       "sine_with_dwell", [](const ParamReader& r) { return std::make_unique<SineWithDwellAnalysis>(r); },
       {"FMVSS 126 sine with dwell: A at 0.3 g (steady state), 0.7 Hz sine with 500 ms dwell from 1.5 A; yaw-rate "
@@ -417,29 +390,12 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
        "closed loop (its path_control plugin follows the lane centres), cone strikes of the body outline, the highest "
        "passing entry speed by bisection; tables iso3888_runs, iso3888_cones, iso3888_best(_corners), "
        "iso3888_fail(_corners)",
-       {{"vehicle_width_m", "m", "0", "b; 0 = widest track + tire_width_m"},
-        {"tire_width_m", "m", "0.195", "tire section width (vehicle width = track + this)"},
-        {"front_overhang_m", "m", "0.8", "body front ahead of the front axle"},
-        {"rear_overhang_m", "m", "0.7", "body rear behind the rear axle"},
-        {"entry_x_m", "m", "30", "straight run before section 1"},
-        {"lead_out_m", "m", "15", "run on after section 5"},
-        {"transition_extension_m", "m", "4", "reference lane changes start/end this far inside the lanes"},
-        {"line_clearance_m", "m", "0.15", "reference line: body side this far from the inside cone lines (< 0: lane centres)"},
-        {"path_controller", "-", "\"path_control\"", "the scene's path_control plugin (its path is replaced)"},
-        {"speed_hold", "-", "\"\"", "the scene's speed_hold plugin set to the entry speed; \"\" = coast"},
-        {"speed_low_m_s", "m/s", "8", "bisection bracket low end (must pass)"},
-        {"speed_high_m_s", "m/s", "30", "bisection bracket high end"},
-        {"speed_tolerance_m_s", "m/s", "0.1", "bisection stops at this bracket width"},
-        {"abort_path_error_m", "m", "2", "a run this far off the path stops and fails"},
-        {"spin_limit_rad", "rad", "0.5", "|side slip| beyond this: spin-out, fails"},
-        {"sample_s", "s", "0.005", "sampling of the motion (cone check)"},
-        {"max_steps", "", "40000", "integrator steps a run may take (beyond: stopped, fails)"},
-        {"integrator", "-", "rk_merson 1e-6", "integrator settings"}}});
+       concat(Iso3888Keys::fields().describe(), Iso3888Settings::fields().describe())});
   registry.addAnalysis(
       "vehicle_report", [](const ParamReader& r) { return std::make_unique<VehicleReportAnalysis>(r); },
       {"static corner/axle loads and heights (equilibrium solver) and suspension kinematics over wheel travel "
        "(camber, toe, track change, recession, wheel rate, roll centre); tables kinematics_<axle>.csv",
-       {{"travel_range_m", "m", "0.08", "wheel travel +- this"}, {"travel_step_m", "m", "0.01", "travel step"}}});
+       TravelKeys::fields().describe()});
 }
 
 }  // namespace vdyn

@@ -1,79 +1,183 @@
 #include "vdyn/vehicles/handling_vehicles.h"
 
+#include <algorithm>
 #include <cmath>
+#include <sstream>
+
+#include "vdyn/core/text.h"
+#include "vdyn/vehicles/bicycle.h"
+#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/quarter_car.h"
 
 namespace vdyn {
+
+const FieldTable<HandlingSetup>& HandlingSetup::fields() {
+  using S = HandlingSetup;
+  static const auto t =
+      FieldTable<S>()
+          .string("rear_strategy", &S::rear_strategy,
+                  "4WS rear steer: 2ws, linear (Kr(U) of linear_bicycle), nonlinear (kr_table)")
+          .string("kr_table", &S::kr_table, "coefficient table of the nonlinear strategy")
+          .custom("linear_bicycle", "-", "chapter 6 values", "linear bicycle of the linear strategy (mass_kg, ...)",
+                  [](const ParamReader& r, S& s) {
+                    if (r.has("linear_bicycle")) s.linear = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
+                  })
+          .number("tire_width_m", &S::tire_width_m, "m", "tire section width (vehicle width = track + this)");
+  return t;
+}
+
+HandlingSetup HandlingSetup::fromParams(const ParamReader& r) {
+  HandlingSetup s;
+  fields().read(r, s);
+  const auto& names = rearSteerStrategyNames();
+  if (std::find(names.begin(), names.end(), s.rear_strategy) == names.end())
+    throw Error(r.at("rear_strategy") + ": unknown rear steer strategy '" + s.rear_strategy + "'; known: 2ws, linear, nonlinear");
+  requirePositive(s.tire_width_m, r.at("tire_width_m"));
+  return s;
+}
+
+Json HandlingScene::describePlugins() const { return {{"replaced", replaced_plugins}, {"added", added_plugins}}; }
 
 double vehicleWidth(double track, double tireWidth) {
   requirePositive(tireWidth, "tire_width_m");
   return track + tireWidth;
 }
 
-std::unique_ptr<HandlingBuild> makeHandlingFourWs(const FourWsParams& params, const std::string& strategy,
-                                                  const LinearBicycleParams& linear, const KrTable* table,
-                                                  double tireWidth) {
-  auto b = std::make_unique<HandlingBuild>();
-  HandlingVehicle& v = b->vehicle;
-  v.name = "4ws/" + strategy;
-  v.rear_strategy = strategy == "2ws" ? nullptr : makeRearSteerStrategy(strategy, linear, table);
-  if (strategy == "2ws") makeRearSteerStrategy(strategy, linear, table);  // validates
-  b->fourws = std::make_unique<FourWsVehicle>(params);
-  FourWsVehicle& car = *b->fourws;
-  v.front = std::make_shared<ProgrammableCommand>(0.0);
-  v.rear = std::make_shared<ProgrammableCommand>(0.0);
-  car.addAxleSteering("front_steer", true, v.front);
-  car.addAxleSteering("rear_steer", false, v.rear);
-  v.speed = &static_cast<const SpeedHoldPlugin&>(
-      car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0)));
-  addHandlingOutputs(car.updScene(), "chassis", v.front, v.rear);
-  v.scene = &car.getScene();
-  v.wheel_bodies = {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"};
-  const SimTK::Vec3 f = wheelCentreInChassis(car.cornerParams(RF)), r = wheelCentreInChassis(car.cornerParams(RR));
-  v.wheelbase_m = f[0] - r[0];
-  v.width_m = vehicleWidth(2 * std::max(std::abs(f[1]), std::abs(r[1])), tireWidth);
-  b->footprint = {v.width_m, f[0], r[0]};
-  v.gravity_m_s2 = params.gravity_m_per_s2;
-  const FourWsVehicle* carp = &car;
-  const SpeedHoldPlugin* sp = v.speed;
-  v.make_initial_state = [carp, sp](double U) {
-    SimTK::State s = carp->makeInitialState(U);
-    sp->setSpeed(s, U);
-    return s;
-  };
-  v.validate();
-  return b;
+namespace {
+/// What the tests need from the vehicle's design data.
+struct Geometry {
+  VehicleFootprint footprint;
+  double wheelbase_m = 0, gravity_m_s2 = 0;
+};
+
+Geometry geometryOf(const Vehicle& vehicle, double tireWidth) {
+  Geometry g;
+  if (vehicle.type() == "fourws") {
+    const FourWsVehicle& car = vehicle.getConcrete<FourWsVehicle>();
+    const SimTK::Vec3 f = wheelCentreInChassis(car.cornerParams(RF)), r = wheelCentreInChassis(car.cornerParams(RR));
+    g.footprint = {vehicleWidth(2 * std::max(std::abs(f[1]), std::abs(r[1])), tireWidth), f[0], r[0]};
+    g.wheelbase_m = f[0] - r[0];
+    g.gravity_m_s2 = car.params().gravity_m_per_s2;
+  } else if (vehicle.type() == "bicycle") {
+    const BicycleParams& p = vehicle.getConcrete<Bicycle>().params();
+    g.footprint = {vehicleWidth(std::max(p.front_track_m, p.rear_track_m), tireWidth), p.front_axle_m[0],
+                   p.rear_axle_m[0]};
+    g.wheelbase_m = p.front_axle_m[0] - p.rear_axle_m[0];
+    g.gravity_m_s2 = p.gravity_m_per_s2;
+  } else {
+    throw Error("handling tests run on vehicle types fourws and bicycle (their wheelbase and tracks), not '" +
+                vehicle.type() + "'");
+  }
+  return g;
 }
 
-std::unique_ptr<HandlingBuild> makeHandlingBicycle(const BicycleParams& params, double tireWidth) {
-  auto b = std::make_unique<HandlingBuild>();
-  HandlingVehicle& v = b->vehicle;
-  v.name = "bicycle";
-  b->bicycle = std::make_unique<Bicycle>(params);
-  Bicycle& bike = *b->bicycle;
+bool hasAttachment(const Vehicle& v, const std::string& name) {
+  const auto names = v.getAttachmentNames();
+  return std::find(names.begin(), names.end(), name) != names.end();
+}
+
+/// A steering constraint on the knuckles of an attachment (front_axle,
+/// rear_axle), held on `command`: the attachment's chassis, knuckles and
+/// spin axis bindings, as the scene's "steering" entries read them.
+std::unique_ptr<SteeringPlugin> makeAxleSteering(const std::string& name, const Attachment& a,
+                                                 std::shared_ptr<const SteeringCommand> command) {
+  const std::string chassis = a.count("chassis") ? a.at("chassis") : "chassis";
+  const std::vector<std::string> knuckles = splitList(a.at("knuckles"));
+  if (!a.count("spin_axis")) return std::make_unique<SteeringPlugin>(name, chassis, knuckles, std::move(command));
+  std::istringstream in(a.at("spin_axis"));
+  SimTK::Vec3 axis;
+  if (!(in >> axis[0] >> axis[1] >> axis[2]))
+    throw Error("steering '" + name + "': spin_axis binding '" + a.at("spin_axis") + "': expected 3 numbers");
+  return std::make_unique<SteeringPlugin>(name, chassis, knuckles, std::move(command), SimTK::UnitVec3(axis));
+}
+
+/// The scene's plugins a handling test replaces: steering constraints, speed
+/// holds and every controller (controllers drive the steering the test programs).
+bool replacedByTest(const Plugin& p) {
+  if (p.kind() == PluginKind::Controller) return true;
+  return p.kind() == PluginKind::Constraint &&
+         (dynamic_cast<const SteeringPlugin*>(&p) || dynamic_cast<const SpeedHoldPlugin*>(&p));
+}
+
+std::string label(const Plugin& p) { return p.name() + " (" + p.type() + ")"; }
+
+/// The scene built without the plugins a handling test replaces (their names
+/// in `replaced`): the description without those "plugins" entries.
+BuiltScene buildWithoutReplaced(const SceneDescription& d, std::vector<std::string>* replaced) {
+  BuiltScene built = d.build();
+  std::vector<std::string> names;
+  for (const auto& p : built.scene().getPlugins())
+    if (replacedByTest(*p)) {
+      names.push_back(p->name());
+      replaced->push_back(label(*p));
+    }
+  if (names.empty()) return built;
+  Json j = d.json();
+  Json kept = Json::array();
+  for (const auto& e : j.at("plugins"))
+    if (!e.contains("name") || std::find(names.begin(), names.end(), e.at("name").get<std::string>()) == names.end())
+      kept.push_back(e);
+  j["plugins"] = kept;
+  return SceneDescription::fromJson(std::move(j), d.path(), d.registry()).build();
+}
+}  // namespace
+
+VehicleFootprint calcVehicleFootprint(const Vehicle& vehicle, double tireWidth) {
+  return geometryOf(vehicle, tireWidth).footprint;
+}
+
+std::unique_ptr<HandlingScene> buildHandlingScene(const SceneDescription& d, const HandlingSetup& setup) {
+  auto h = std::make_unique<HandlingScene>();
+  h->built = buildWithoutReplaced(d, &h->replaced_plugins);
+  Vehicle& veh = *h->built.vehicle;
+  Scene& sc = h->built.scene();
+  HandlingVehicle& v = h->vehicle;
+  const Geometry g = geometryOf(veh, setup.tire_width_m);
+  if (!hasAttachment(veh, "front_axle"))
+    throw Error(d.path() + ": handling tests steer the attachment front_axle; vehicle '" + veh.type() + "' has none");
+  const bool rear = hasAttachment(veh, "rear_axle") && veh.getAttachment("rear_axle").count("knuckles");
+  v.name = (veh.type() == "fourws" ? std::string("4ws") : veh.type()) + (rear ? "/" + setup.rear_strategy : "");
+  if (rear) {
+    KrTable table;
+    const bool needTable = setup.rear_strategy == "nonlinear";
+    if (needTable) table = KrTable::fromFile(d.resolve(setup.kr_table));
+    auto strategy = makeRearSteerStrategy(setup.rear_strategy, setup.linear, needTable ? &table : nullptr);
+    if (setup.rear_strategy != "2ws") v.rear_strategy = strategy;
+  }
+  auto add = [&](std::unique_ptr<Plugin> p) -> const Plugin& {
+    h->added_plugins.push_back(label(*p));
+    return sc.addPlugin(std::move(p));
+  };
   v.front = std::make_shared<ProgrammableCommand>(0.0);
-  bike.addFrontSteering("front_steer", v.front);
-  v.speed = &static_cast<const SpeedHoldPlugin&>(
-      bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0)));
-  addHandlingOutputs(bike.updScene(), "chassis", v.front, nullptr);
-  v.scene = &bike.getScene();
-  v.wheel_bodies = {"front_axle", "rear_axle"};
-  v.wheelbase_m = params.front_axle_m[0] - params.rear_axle_m[0];
-  v.width_m = vehicleWidth(std::max(params.front_track_m, params.rear_track_m), tireWidth);
-  b->footprint = {v.width_m, params.front_axle_m[0], params.rear_axle_m[0]};
-  v.gravity_m_s2 = params.gravity_m_per_s2;
-  const Bicycle* bp = &bike;
+  add(makeAxleSteering("front_steer", veh.getAttachment("front_axle"), v.front));
+  if (rear) {
+    v.rear = std::make_shared<ProgrammableCommand>(0.0);
+    add(makeAxleSteering("rear_steer", veh.getAttachment("rear_axle"), v.rear));
+  }
+  const std::string chassis = veh.getAttachment("chassis").at("chassis");
+  if (setup.speed_hold)
+    v.speed = &static_cast<const SpeedHoldPlugin&>(add(std::make_unique<SpeedHoldPlugin>("speed_hold", chassis, 10.0)));
+  addHandlingOutputs(sc, chassis, v.front, v.rear);
+  v.scene = &sc;
+  v.chassis_body = chassis;
+  if (hasAttachment(veh, "wheels")) v.wheel_bodies = splitList(veh.getAttachment("wheels").at("wheels"));
+  v.wheelbase_m = g.wheelbase_m;
+  v.width_m = g.footprint.width_m;
+  v.gravity_m_s2 = g.gravity_m_s2;
+  h->footprint = g.footprint;
+  const Vehicle* vp = &veh;
   const SpeedHoldPlugin* sp = v.speed;
-  v.make_initial_state = [bp, sp](double U) {
-    SimTK::State s = bp->makeInitialState(U);
-    sp->setSpeed(s, U);
+  v.make_initial_state = [vp, sp](double U) {
+    SimTK::State s = vp->makeInitialState(U);
+    if (sp) sp->setSpeed(s, U);
     return s;
   };
-  v.validate();
-  return b;
+  if (setup.speed_hold) v.validate();
+  return h;
 }
 
 namespace {
-SuspensionCorner cornerOf(const Scene& sc, const std::string& name, const DoubleWishboneCorner& c) {
+SuspensionCorner cornerOf(const std::string& name, const DoubleWishboneCorner& c) {
   SuspensionCorner k;
   k.name = name;
   k.lower_arm = c.lower_arm;
@@ -81,21 +185,18 @@ SuspensionCorner cornerOf(const Scene& sc, const std::string& name, const Double
   k.wheel = c.wheel;
   k.free = {c.knuckle.getMobilizedBodyIndex(), c.upper_arm.getMobilizedBodyIndex()};
   k.spring = c.spring;
-  (void)sc;
   return k;
 }
-}  // namespace
 
-VehicleReport makeFourWsReport(const FourWsParams& params, const std::vector<double>& travels) {
-  FourWsVehicle car(params);
-  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.0));
-  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.0));
-  const Scene& sc = car.getScene();
+VehicleReport makeFourWsReport(const HandlingScene& h, const std::vector<double>& travels) {
+  const FourWsVehicle& car = h.built.vehicleAs<FourWsVehicle>();
+  const FourWsParams& params = car.params();
+  const Scene& sc = h.built.scene();
   // Static equilibrium: the steady-state equations at zero speed (no speed
   // hold): the chassis x, y, yaw and wheel spin angles are ineffective, the
   // speeds are unknowns that solve to zero.
-  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0));
-  const SteadyStateResult r = solver.solve(car.makeInitialState(0.0));
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, h.vehicle.chassis_body, h.vehicle.wheel_bodies, 0));
+  const SteadyStateResult r = solver.solve(h.vehicle.make_initial_state(0.0));
   SimTK::State s = r.state;
   sc.getSystem().realize(s, SimTK::Stage::Velocity);
   VehicleReport rep;
@@ -115,17 +216,18 @@ VehicleReport makeFourWsReport(const FourWsParams& params, const std::vector<dou
   rep.com_height_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[2] - road;
   const double y0 = car.chassis().getBodyOriginLocation(s)[1];
   for (int c : {RF, RR}) {
-    SuspensionCorner k = cornerOf(sc, cornerName(c), car.corner(c));
+    SuspensionCorner k = cornerOf(cornerName(c), car.corner(c));
     k.centre_plane_y_m = y0;
     rep.kinematics.push_back({c == RF ? "front" : "rear", calcSuspensionKinematics(sc, s, k, travels, road)});
   }
   return rep;
 }
 
-VehicleReport makeQuarterCarReport(const QuarterCarParams& params, const std::vector<double>& travels) {
-  QuarterCar car(params);
-  const Scene& sc = car.getScene();
-  SimTK::State s = car.makeInitialState(true);
+VehicleReport makeQuarterCarReport(const BuiltScene& built, const std::vector<double>& travels) {
+  const QuarterCar& car = built.vehicleAs<QuarterCar>();
+  const QuarterCarParams& params = car.params();
+  const Scene& sc = built.scene();
+  SimTK::State s = built.vehicle->makeInitialState(0.0);
   sc.getSystem().realize(s, SimTK::Stage::Velocity);
   VehicleReport rep;
   rep.vehicle = "quarter_car";
@@ -142,10 +244,26 @@ VehicleReport makeQuarterCarReport(const QuarterCarParams& params, const std::ve
   const double road = makeRoad(params.road)->height(0, 0, 0);
   rep.chassis_origin_height_m = car.chassis().getBodyOriginLocation(s)[2] - road;
   rep.com_height_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[2] - road;
-  SuspensionCorner k = cornerOf(sc, "corner", car.corner());
+  SuspensionCorner k = cornerOf("corner", car.corner());
   k.centre_plane_y_m = car.chassis().getBodyOriginLocation(s)[1];
   rep.kinematics.push_back({"corner", calcSuspensionKinematics(sc, s, k, travels, road)});
   return rep;
+}
+}  // namespace
+
+VehicleReport makeVehicleReport(const SceneDescription& d, const std::vector<double>& travels) {
+  const std::string type = d.json().at("vehicle").at("type").get<std::string>();
+  if (type == "fourws") {
+    HandlingSetup setup;
+    setup.speed_hold = false;
+    const auto h = buildHandlingScene(d, setup);
+    VehicleReport rep = makeFourWsReport(*h, travels);
+    rep.replaced_plugins = h->replaced_plugins;
+    rep.added_plugins = h->added_plugins;
+    return rep;
+  }
+  if (type == "quarter_car") return makeQuarterCarReport(d.build(), travels);
+  throw Error(d.path() + ": vehicle_report runs on vehicle types fourws and quarter_car, not '" + type + "'");
 }
 
 }  // namespace vdyn

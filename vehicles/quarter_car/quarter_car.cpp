@@ -18,7 +18,7 @@ void QuarterCarParams::validate() const {
   if (tire_plugin.empty()) throw Error("quarter car tire plugin name is empty");
 }
 
-QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r) {
+QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r, const PluginRegistry* registry) {
   QuarterCarParams p;
   const ParamReader vehicle = ParamReader::fromFile(r.string("vehicle_data"));
   const std::string cornerName = r.stringOr("corner", "front_right");
@@ -47,13 +47,13 @@ QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r) {
   p.spring_free_length_from_ride_height = r.booleanOr("spring_free_length_from_ride_height", false);
   requirePositive(p.chassis_mass_kg, r.at("chassis_mass_kg"));
   p.validate();
-  return p.spring_free_length_from_ride_height ? p.withRideHeightSpring() : p;
+  return p.spring_free_length_from_ride_height ? p.withRideHeightSpring(registry) : p;
 }
 
-QuarterCarParams QuarterCarParams::withRideHeightSpring() const {
+QuarterCarParams QuarterCarParams::withRideHeightSpring(const PluginRegistry* registry) const {
   QuarterCarParams p = *this;
   p.spring_free_length_from_ride_height = false;
-  const QuarterCar car(p);
+  const QuarterCar car(p, registry ? *registry : builtinPlugins());
   SimTK::State s = car.makeInitialState(false);
   const auto arm = car.corner().lower_arm;
   // Equilibrium of everything but the lower arm, held at its tabulated angle;

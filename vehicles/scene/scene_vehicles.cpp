@@ -92,7 +92,7 @@ class QuarterCarSceneVehicle : public Vehicle {
  public:
   QuarterCarSceneVehicle(const VehicleSpec& spec)
       : Vehicle("quarter_car"),
-        car_(QuarterCarParams::fromParams(spec.data), *spec.registry),
+        car_(QuarterCarParams::fromParams(spec.data, spec.registry), *spec.registry),
         rideHeightSpring_(spec.data.json().value("spring_free_length_from_ride_height", false)) {
     attachments_["chassis"] = {{"chassis", "chassis"}};
     attachments_["corner"] = {{"chassis", "chassis"}, {"wheel", "wheel"}, {"knuckle", "knuckle"}};

@@ -7,6 +7,7 @@
 
 #include "vdyn/core/recorder.h"
 #include "vdyn/handling/handling.h"
+#include "vdyn/path_control/path_control.h"
 
 namespace vdyn {
 
@@ -142,25 +143,38 @@ void Iso3888Settings::validate() const {
   if (max_steps < 1) throw Error("ISO 3888-2 max_steps must be >= 1, got " + std::to_string(max_steps));
 }
 
+const FieldTable<Iso3888Settings>& Iso3888Settings::fields() {
+  using S = Iso3888Settings;
+  static const auto t =
+      FieldTable<S>()
+          .number("vehicle_width_m", &S::vehicle_width_m, "m", "b; 0 = widest track + tire_width_m")
+          .number("front_overhang_m", &S::front_overhang_m, "m", "body front ahead of the front axle")
+          .number("rear_overhang_m", &S::rear_overhang_m, "m", "body rear behind the rear axle")
+          .number("entry_x_m", &S::entry_x_m, "m", "straight run before section 1")
+          .number("lead_out_m", &S::lead_out_m, "m", "run on after section 5")
+          .number("transition_extension_m", &S::transition_extension_m, "m",
+                  "reference lane changes start/end this far inside the lanes")
+          .number("line_clearance_m", &S::line_clearance_m, "m",
+                  "reference line: body side this far from the inside cone lines (< 0: lane centres)")
+          .string("path_controller", &S::path_controller, "the scene's path_control plugin (its path is replaced)")
+          .string("speed_hold", &S::speed_hold, "the scene's speed_hold plugin set to the entry speed; \"\" = coast")
+          .number("speed_low_m_s", &S::speed_low_m_s, "m/s", "bisection bracket low end (must pass)")
+          .number("speed_high_m_s", &S::speed_high_m_s, "m/s", "bisection bracket high end")
+          .number("speed_tolerance_m_s", &S::speed_tolerance_m_s, "m/s", "bisection stops at this bracket width")
+          .number("abort_path_error_m", &S::abort_path_error_m, "m", "a run this far off the path stops and fails")
+          .number("spin_limit_rad", &S::spin_limit_rad, "rad", "|side slip| beyond this: spin-out, fails")
+          .number("sample_s", &S::sample_s, "s", "sampling of the motion (cone check)")
+          .integer("max_steps", &S::max_steps, "", "integrator steps a run may take (beyond: stopped, fails)")
+          .custom("integrator", "-", "rk_merson 1e-6", "integrator settings",
+                  [](const ParamReader& r, S& s) {
+                    if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+                  });
+  return t;
+}
+
 Iso3888Settings Iso3888Settings::fromParams(const ParamReader& r) {
   Iso3888Settings s;
-  s.vehicle_width_m = r.numberOr("vehicle_width_m", s.vehicle_width_m);
-  s.front_overhang_m = r.numberOr("front_overhang_m", s.front_overhang_m);
-  s.rear_overhang_m = r.numberOr("rear_overhang_m", s.rear_overhang_m);
-  s.entry_x_m = r.numberOr("entry_x_m", s.entry_x_m);
-  s.lead_out_m = r.numberOr("lead_out_m", s.lead_out_m);
-  s.transition_extension_m = r.numberOr("transition_extension_m", s.transition_extension_m);
-  s.line_clearance_m = r.numberOr("line_clearance_m", s.line_clearance_m);
-  s.path_controller = r.stringOr("path_controller", s.path_controller);
-  s.speed_hold = r.stringOr("speed_hold", s.speed_hold);
-  s.speed_low_m_s = r.numberOr("speed_low_m_s", s.speed_low_m_s);
-  s.speed_high_m_s = r.numberOr("speed_high_m_s", s.speed_high_m_s);
-  s.speed_tolerance_m_s = r.numberOr("speed_tolerance_m_s", s.speed_tolerance_m_s);
-  s.abort_path_error_m = r.numberOr("abort_path_error_m", s.abort_path_error_m);
-  s.spin_limit_rad = r.numberOr("spin_limit_rad", s.spin_limit_rad);
-  s.sample_s = r.numberOr("sample_s", s.sample_s);
-  s.max_steps = int(r.numberOr("max_steps", s.max_steps));
-  if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
+  fields().read(r, s);
   s.validate();
   return s;
 }
@@ -186,11 +200,10 @@ void Iso3888Run::writeCsv(const std::string& path) const {
 }
 
 namespace {
-/// The scene's plugin object named `name`, or null.
-const Json* findPlugin(const Json& scene, const std::string& name) {
-  if (!scene.contains("plugins")) return nullptr;
-  for (const auto& p : scene.at("plugins"))
-    if (p.contains("name") && p.at("name").get<std::string>() == name) return &p;
+/// The built scene's plugin named `name`, or null.
+const Plugin* findPlugin(const Scene& scene, const std::string& name) {
+  for (const auto& p : scene.getPlugins())
+    if (p->name() == name) return p.get();
   return nullptr;
 }
 double maxAbs(const std::vector<double>& v) {
@@ -203,13 +216,22 @@ double maxAbs(const std::vector<double>& v) {
 Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, const Iso3888Layout& L,
                       const BodyOutline& body, double U) {
   requirePositive(U, "ISO 3888-2 entry speed");
-  const Json* pc = findPlugin(desc.json(), set.path_controller);
-  if (!pc)
-    throw Error(desc.path() + ": ISO 3888-2 path_controller '" + set.path_controller + "': no plugin of that name");
-  const std::string frontSteer = pc->value("steering", std::string());
-  std::string rearSteer;
-  for (const auto& p : desc.json().at("plugins"))
-    if (p.value("type", std::string()) == "rear_steer") rearSteer = p.value("rear_steering", std::string());
+  // The scene's plugins the run reads, from the built scene (typed access):
+  // the path controller and the steering it drives, the rear-steer
+  // controller's rear steering, the speed hold.
+  std::string frontSteer, rearSteer;
+  {
+    const BuiltScene probe = desc.build();
+    const auto* pc = dynamic_cast<const PathControlPlugin*>(findPlugin(probe.scene(), set.path_controller));
+    if (!pc)
+      throw Error(desc.path() + ": ISO 3888-2 path_controller '" + set.path_controller +
+                  "': no path_control plugin of that name");
+    frontSteer = pc->steeringPlugin();
+    for (const auto& p : probe.scene().getPlugins())
+      if (const auto* rs = dynamic_cast<const RearSteerPlugin*>(p.get())) rearSteer = rs->rearSteering();
+    if (!set.speed_hold.empty() && !dynamic_cast<const SpeedHoldPlugin*>(findPlugin(probe.scene(), set.speed_hold)))
+      throw Error(desc.path() + ": ISO 3888-2 speed_hold '" + set.speed_hold + "': no speed_hold plugin of that name");
+  }
   const DoubleLaneChangeParams path = L.makeReferencePath(set.transition_extension_m, set.line_clearance_m);
   const Json pathJson = {{"type", "double_lane_change"},
                          {"start_y_m", path.start_y_m},
@@ -217,8 +239,6 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
                          {"second", {{"start_x_m", path.second.start_x_m}, {"length_m", path.second.length_m}, {"shift_m", path.second.shift_m}}}};
   std::vector<Override> ov = {{"vehicle.initial_speed_m_s", U}, {"plugins." + set.path_controller + ".path", pathJson}};
   if (!set.speed_hold.empty()) {
-    if (!findPlugin(desc.json(), set.speed_hold))
-      throw Error(desc.path() + ": ISO 3888-2 speed_hold '" + set.speed_hold + "': no plugin of that name");
     ov.push_back({"plugins." + set.speed_hold + ".speed_m_s", U});
   }
   Iso3888Run out;

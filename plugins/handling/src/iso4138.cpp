@@ -16,14 +16,22 @@ void ConstantRadiusSettings::validate() const {
                 formatValue(speed_start_m_s) + ")");
 }
 
+const FieldTable<ConstantRadiusSettings>& ConstantRadiusSettings::fields() {
+  using S = ConstantRadiusSettings;
+  static const auto t =
+      FieldTable<S>()
+          .number("radius_m", &S::radius_m, "m", "path radius of the chassis origin")
+          .number("speed_start_m_s", &S::speed_start_m_s, "m/s", "first speed")
+          .number("speed_step_m_s", &S::speed_step_m_s, "m/s", "speed increment")
+          .number("speed_max_m_s", &S::speed_max_m_s, "m/s", "last speed tried")
+          .number("limit_tolerance_m_s", &S::limit_tolerance_m_s, "m/s", "bisection tolerance of the limit speed")
+          .boolean("stability", &S::stability, "eigenvalues at each point");
+  return t;
+}
+
 ConstantRadiusSettings ConstantRadiusSettings::fromParams(const ParamReader& r) {
   ConstantRadiusSettings s;
-  s.radius_m = r.numberOr("radius_m", s.radius_m);
-  s.speed_start_m_s = r.numberOr("speed_start_m_s", s.speed_start_m_s);
-  s.speed_step_m_s = r.numberOr("speed_step_m_s", s.speed_step_m_s);
-  s.speed_max_m_s = r.numberOr("speed_max_m_s", s.speed_max_m_s);
-  s.limit_tolerance_m_s = r.numberOr("limit_tolerance_m_s", s.limit_tolerance_m_s);
-  s.stability = r.booleanOr("stability", s.stability);
+  fields().read(r, s);
   s.validate();
   return s;
 }
@@ -66,6 +74,9 @@ ConstantRadiusResult runConstantRadius(const HandlingVehicle& v, const ConstantR
     p.rear_rad = v.rearAngle(U, p.front_rad);
     p.side_slip_rad = sc.evalOutput("chassis.side_slip_rad", s);
     p.roll_rad = sc.evalOutput("chassis.roll_rad", s);
+    SimTK::State sa = r.state;  // another copy, realized through Stage::Acceleration
+    sc.getSystem().realize(sa, SimTK::Stage::Acceleration);
+    p.speed_hold_force_N = v.speed->calcForce(sa);
     p.iterations = r.iterations;
     p.residual_evaluations = r.residual_evaluations;
     p.solve_wall_time_s = r.wall_time_s;

@@ -1,10 +1,17 @@
 #pragma once
-// The App. A 4WS vehicle and the nonlinear bicycle prepared for the handling
-// tests (plugins/handling): programmable front (and rear) steering commands,
-// a speed hold, the handling outputs, and the rear-steer strategy by name.
+// The handling tests' scene (plugins/handling): a scene file's built scene --
+// its vehicle with every plugin the scene lists -- with the plugins the
+// open-loop tests drive added: programmable front (and rear) steering
+// commands, a speed hold and the handling outputs, and the rear-steer strategy
+// by name. The scene's own steering constraints, speed holds and controllers
+// (which would fight the test's steering) are replaced; its force elements and
+// other constraints stay. One composition: SceneDescription::build().
 #include <memory>
 #include <string>
+#include <vector>
 
+#include "vdyn/core/fields.h"
+#include "vdyn/core/scene_file.h"
 #include "vdyn/handling/handling.h"
 #include "vdyn/handling/iso3888.h"
 #include "vdyn/handling/vehicle_report.h"
@@ -14,25 +21,48 @@
 
 namespace vdyn {
 
-/// A built vehicle and its HandlingVehicle (which points into it).
-struct HandlingBuild {
-  std::unique_ptr<FourWsVehicle> fourws;  ///< set for the 4WS vehicle
-  std::unique_ptr<Bicycle> bicycle;       ///< set for the bicycle
+/// The keys every open-loop handling analysis takes besides its test's own
+/// (one table: read by the analyses, printed by `vdyn list`).
+struct HandlingSetup {
+  std::string rear_strategy = "2ws";      ///< 2ws | linear | nonlinear (4WS rear steer)
+  std::string kr_table = "kr_table.json"; ///< coefficient table of the nonlinear strategy
+  LinearBicycleParams linear;             ///< the linear strategy's bicycle
+  double tire_width_m = 0.195;            ///< tire section width, m (vehicle width = track + this)
+  /// Add a speed hold (the transient and steady-turn tests); false: none (vehicle_report at rest).
+  bool speed_hold = true;
+  static const FieldTable<HandlingSetup>& fields();
+  /// fields(), then checks the strategy name and the width.
+  static HandlingSetup fromParams(const ParamReader& r);
+};
+
+/// A built scene prepared for the handling tests, and its HandlingVehicle
+/// (which points into it).
+struct HandlingScene {
+  BuiltScene built;
   HandlingVehicle vehicle;
-  VehicleFootprint footprint;             ///< width and axle positions (ISO 3888-2 body outline)
+  VehicleFootprint footprint;                 ///< width and axle positions (ISO 3888-2 body outline)
+  std::vector<std::string> replaced_plugins;  ///< the scene's plugins the test replaced ("name (type)")
+  std::vector<std::string> added_plugins;     ///< the plugins the test added ("name (type)")
+  /// {"replaced": [...], "added": [...]} for an analysis's summary.
+  Json describePlugins() const;
 };
 
 /// Width of the vehicle over the tires, m: the widest track plus one tire
 /// section width (tire_width_m, default 0.195 m: the seed gives none).
 double vehicleWidth(double track_m, double tire_width_m);
 
-/// The App. A vehicle with `rear_strategy` "2ws", "linear" (Kr(U) of `linear`)
-/// or "nonlinear" (Kr = C1 + C2 delta_f^2 from `table`, required then).
-std::unique_ptr<HandlingBuild> makeHandlingFourWs(const FourWsParams& params, const std::string& rear_strategy,
-                                                  const LinearBicycleParams& linear, const KrTable* table,
-                                                  double tire_width_m = 0.195);
-/// The nonlinear bicycle (front steering only).
-std::unique_ptr<HandlingBuild> makeHandlingBicycle(const BicycleParams& params, double tire_width_m = 0.195);
+/// Width and axle positions of a built vehicle from its design data (fourws,
+/// bicycle; throws Error naming the vehicle type for another).
+VehicleFootprint calcVehicleFootprint(const Vehicle& vehicle, double tire_width_m);
+
+/// Builds `scene` (SceneDescription::build: its vehicle and every plugin it
+/// lists; plugin-library types included), replaces its steering constraints,
+/// speed holds and controllers with programmable steering on the attachments
+/// front_axle (and rear_axle when the vehicle has it: the 4WS vehicle) and a
+/// speed hold on chassis (setup.speed_hold), and adds the handling outputs.
+/// The rear-steer strategy: setup.rear_strategy (kr_table resolved from the
+/// scene). Throws Error naming the scene if the vehicle has no front_axle.
+std::unique_ptr<HandlingScene> buildHandlingScene(const SceneDescription& scene, const HandlingSetup& setup);
 
 /// Vehicle report at rest on a flat road with the steering held at zero.
 struct VehicleReport {
@@ -47,18 +77,19 @@ struct VehicleReport {
   double com_height_m = 0;                ///< whole-vehicle c.m. above the road, m
   /// Per axle (a corner standing for it: "front" = rf, "rear" = rr; the quarter car: "corner").
   std::vector<std::pair<std::string, std::vector<KinematicsPoint>>> kinematics;
+  std::vector<std::string> replaced_plugins, added_plugins;  ///< as in HandlingScene
 };
 
-/// The 4WS vehicle's report: static equilibrium by the steady-state solver at
-/// zero speed (unknowns q, u, lambda; the speeds solve to zero), kinematics of
-/// the RF and RR corners over `travels_m`.
-VehicleReport makeFourWsReport(const FourWsParams& params, const std::vector<double>& travels_m);
+/// The report of a scene's vehicle (fourws, quarter_car), on the built scene
+/// with its plugins. 4WS: the steering held at zero (the scene's steering and
+/// controllers replaced, no speed hold), static equilibrium by the steady-state
+/// solver at zero speed (unknowns q, u, lambda; the speeds solve to zero),
+/// kinematics of the RF and RR corners over `travels_m`. Quarter car:
+/// solveStaticEquilibrium (its initial state), kinematics of its corner.
+VehicleReport makeVehicleReport(const SceneDescription& scene, const std::vector<double>& travels_m);
+
 /// Registers the analyses iso4138_constant_radius, iso7401, sine_with_dwell,
 /// iso3888_2 and vehicle_report (scene files; vehicles/handling/handling_analyses.cpp).
 void registerHandlingAnalyses(PluginRegistry& registry);
-
-/// The quarter car's report: static equilibrium by solveStaticEquilibrium
-/// (QuarterCar::makeInitialState), kinematics of its corner.
-VehicleReport makeQuarterCarReport(const QuarterCarParams& params, const std::vector<double>& travels_m);
 
 }  // namespace vdyn

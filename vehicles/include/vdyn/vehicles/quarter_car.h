@@ -42,10 +42,14 @@ struct QuarterCarParams {
   void validate() const;
   /// Reads a quarter-car data file (it names the vehicle data file and corner).
   static QuarterCarParams fromFile(const std::string& path);
-  static QuarterCarParams fromParams(const ParamReader& r);
+  /// `registry`: where the tire plugin is looked up for the ride-height rule
+  /// (nullptr = the built-in plugins; a scene passes its own, so a tire from a
+  /// plugin library works).
+  static QuarterCarParams fromParams(const ParamReader& r, const PluginRegistry* registry = nullptr);
   /// A copy whose corner.spring_free_length_m puts the tabulated configuration in
-  /// static equilibrium (the flag above is then cleared).
-  QuarterCarParams withRideHeightSpring() const;
+  /// static equilibrium (the flag above is then cleared); the tire from
+  /// `registry` (nullptr = the built-in plugins).
+  QuarterCarParams withRideHeightSpring(const PluginRegistry* registry = nullptr) const;
 };
 
 class QuarterCar {

@@ -3,9 +3,9 @@
 // free functions on any vehicle scene. The vehicle is reached only through a
 // HandlingVehicle: its scene, the names of its chassis and wheel bodies, its
 // front (and optional rear) steering commands, its speed hold and the
-// rear-steer strategy that maps the front angle to the rear one. Vehicle
-// builders (vehicles/handling_vehicles.h) fill it for the App. A 4WS vehicle
-// and the bicycle.
+// rear-steer strategy that maps the front angle to the rear one.
+// buildHandlingScene (vehicles/handling_vehicles.h) fills it from a scene
+// file's built scene (the 4WS vehicle, the bicycle): one composition path.
 //
 // Conventions: SI units; steering angles are road-wheel angles, rad, + left;
 // yaw rate rad/s, + left (counter-clockwise seen from above); lateral

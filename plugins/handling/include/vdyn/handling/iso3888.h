@@ -40,6 +40,7 @@
 #include <string>
 #include <vector>
 
+#include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/simulation.h"
@@ -110,6 +111,8 @@ struct Iso3888Settings {
   /// speed_hold, speed_low_m_s, speed_high_m_s, speed_tolerance_m_s,
   /// abort_path_error_m, sample_s, max_steps, integrator.
   static Iso3888Settings fromParams(const ParamReader& r);
+  /// The keys (read by fromParams, listed by `vdyn list`).
+  static const FieldTable<Iso3888Settings>& fields();
   /// b, m; 0 = the vehicle's own (track + tire width, VehicleFootprint).
   double vehicle_width_m = 0;
   /// Body ends beyond the front and rear axles, m (the seed gives no body: the

@@ -22,6 +22,8 @@ struct ConstantRadiusSettings {
   /// Keys radius_m, speed_start_m_s, speed_step_m_s, speed_max_m_s,
   /// limit_tolerance_m_s, stability (each optional; defaults below).
   static ConstantRadiusSettings fromParams(const ParamReader& r);
+  /// The keys (read by fromParams, listed by `vdyn list`).
+  static const FieldTable<ConstantRadiusSettings>& fields();
 
   double radius_m = 100;              ///< R, path radius of the chassis origin, m (> 0; + = left turn)
   double speed_start_m_s = 4;         ///< first speed, m/s
@@ -41,6 +43,10 @@ struct ConstantRadiusPoint {
   double roll_rad = 0;                ///< chassis roll, rad
   double yaw_rate_rad_s = 0;
   double path_radius_m = 0;           ///< U_h / r of the chassis origin (= R to the condition's tolerance), m
+  /// Force the speed hold applies along the direction of travel to hold U0,
+  /// N (> 0 propulsive: it balances the tires' drag; a force F pushing the
+  /// chassis origin along its travel lowers it by F).
+  double speed_hold_force_N = 0;
   /// d delta_f / d a_y along the sweep (three-point differences), rad/(m/s^2).
   double understeer_gradient_rad_per_m_s2 = 0;
   bool stable = true;                 ///< fixed-control stability (all eigenvalue real parts < -1e-6 /s)

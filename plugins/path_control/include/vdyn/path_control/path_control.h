@@ -103,6 +103,8 @@ class PathControlPlugin : public ControllerPlugin {
   PathControlPlugin(std::string name, std::string steeringPlugin, std::string chassisBody,
                     std::shared_ptr<const ReferencePath> path, const PathControlParams& params);
   const PathController& controller() const;
+  /// Name of the state-driven steering plugin the controller drives.
+  const std::string& steeringPlugin() const { return steering_; }
 
  protected:
   void DoAddTo(Scene& scene) override;

@@ -152,6 +152,9 @@ class RearSteerPlugin : public ControllerPlugin {
   RearSteerPlugin(std::string name, std::string rearSteering, std::string frontSteering, std::string chassisBody,
                   std::shared_ptr<const RearSteerStrategy> strategy, const RearSteerParams& params);
   const RearSteerLaw& law() const;
+  /// Names of the rear steering plugin it drives and the front one it reads.
+  const std::string& rearSteering() const { return rear_; }
+  const std::string& frontSteering() const { return front_; }
 
  protected:
   void DoAddTo(Scene& scene) override;
