@@ -128,6 +128,7 @@ struct SensitivityEntry {
   IntegratorSettings integrator;
   SensitivitySettings settings;
   double tolerance = SensitivitySettings{}.tolerance;
+  std::string refinement = "uniform";
   double perturbation = 0;
 };
 
@@ -173,6 +174,9 @@ const FieldTable<SensitivityEntry>& sensitivityFields() {
                     if (r.has("integrator")) e.integrator = IntegratorSettings::fromParams(r.child("integrator"));
                   })
           .number("tolerance", &E::tolerance, "", "mixed: relative tolerance on the error estimate")
+          .string("refinement", &E::refinement,
+                  "mixed: node intervals bisected each pass: uniform (all) | adaptive (those whose interpolation "
+                  "indicator is >= 0.1 of the largest)")
           .number("perturbation", &E::perturbation, "", "finite differences: relative step (0 = from the accuracy)");
   return t;
 }
@@ -220,6 +224,7 @@ class SensitivityAnalysis : public Analysis {
       if (!registry.hasChoice("sensitivity_method", m)) makeSensitivityMethod(m, {}, &registry);
     requirePositive(e_.t_end_s, r.at("t_end_s"));
     e_.settings.tolerance = e_.tolerance;
+    e_.settings.refinement = mixedRefinementFromName(e_.refinement, r.at("refinement"));
     e_.settings.perturbation = e_.perturbation;
   }
 
