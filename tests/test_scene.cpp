@@ -2,12 +2,14 @@
 // overrides, plugin libraries: numbers and named errors.
 #include <gtest/gtest.h>
 
+#include <mutex>
 #include <thread>
 
 #include "test_util.h"
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/core/fields.h"
 #include "vdyn/core/key_path.h"
+#include "vdyn/core/log.h"
 #include "vdyn/core/plugin_library.h"
 #include "vdyn/forces/body_force.h"
 #include "vdyn/core/scene_file.h"
@@ -451,6 +453,39 @@ TEST(SceneAnalyses, StaticEquilibriumTireCarriesWeightPlusBodyForce) {
   EXPECT_NEAR(pushed["equilibrium"]["tire.Fz_N"].get<double>(), mg + 300, 1e-5);
   EXPECT_EQ(pushed["equilibrium"]["push.Fz_N"].get<double>(), -300);
   EXPECT_LT(pushed["equilibrium"]["chassis.z_m"].get<double>(), plain["equilibrium"]["chassis.z_m"].get<double>());
+}
+
+// The libraries' diagnostics go to the log sink the program installs
+// (vdyn/core/log.h), never to stderr by themselves, and do not change results:
+// the static equilibrium's Newton iterations are logged at debug level only
+// while a sink is installed, and the equilibrium is the same bit for bit.
+TEST(Log, SinkReceivesDiagnosticsAndResultsDoNotChange) {
+  const SceneDescription s = SceneDescription::fromJson(R"({
+      "vehicle": {"type": "quarter_car", "data": "quarter_car.json"},
+      "analysis": {"type": "static_equilibrium", "ineffective_bodies": ["wheel"]}})"_json,
+                                                        "qc.json", standardRegistry());
+  EXPECT_FALSE(logEnabled(LogLevel::Debug));  // the default: no sink
+  const Json quiet = runScene(s);
+  std::vector<std::string> lines;
+  std::mutex m;
+  setLogSink([&](LogLevel level, const std::string& text) {
+    std::lock_guard<std::mutex> lock(m);
+    lines.push_back(std::string(logLevelName(level)) + " " + text);
+  });
+  EXPECT_TRUE(logEnabled(LogLevel::Debug));
+  const Json logged = runScene(s);
+  setLogSink(nullptr);
+  EXPECT_FALSE(logEnabled(LogLevel::Debug));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0].rfind("debug equilibrium: iteration 0 alpha ", 0), 0u) << lines[0];
+  EXPECT_EQ(logged["equilibrium"], quiet["equilibrium"]);
+  const std::size_t n = lines.size();
+  runScene(s);
+  EXPECT_EQ(lines.size(), n);  // removed: nothing more arrives
+  setLogSink([&](LogLevel, const std::string& text) { lines.push_back(text); }, LogLevel::Warning);
+  EXPECT_FALSE(logEnabled(LogLevel::Debug));  // below the minimum
+  setLogSink(nullptr);
+  EXPECT_EQ(logFormat("%d %.3f %s", 7, 0.5, "x"), "7 0.500 x");
 }
 
 // Continuation in the speed hold's adjustable speed finds, at its first value,
