@@ -2,11 +2,14 @@
 // overrides, plugin libraries: numbers and named errors.
 #include <gtest/gtest.h>
 
+#include <mutex>
 #include <thread>
 
 #include "test_util.h"
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/core/fields.h"
+#include "vdyn/core/key_path.h"
+#include "vdyn/core/log.h"
 #include "vdyn/core/plugin_library.h"
 #include "vdyn/forces/body_force.h"
 #include "vdyn/core/scene_file.h"
@@ -100,6 +103,117 @@ TEST(Override, ParsesValuesAndAddressesArraysByNameOrIndex) {
                        "plugins has no element named 'c'"));
   EXPECT_TRUE(contains(errorOf([&] { applyOverride(j, Override::parse("x.y.w=1"), "s.json"); }),
                        "x.y is 1, not an object or array"));
+}
+
+TEST(KeyPath, ParsesFormatsAndRoundTrips) {
+  const KeyPath k = KeyPath::parse("plugins.front_steer.command.steps[1].change_rad", "w");
+  ASSERT_EQ(k.parts().size(), 6u);
+  EXPECT_EQ(k.parts()[3].text, "steps");
+  EXPECT_FALSE(k.parts()[3].bracketed);
+  EXPECT_EQ(k.parts()[4].text, "1");
+  EXPECT_TRUE(k.parts()[4].bracketed);
+  EXPECT_EQ(k.format(), "plugins.front_steer.command.steps[1].change_rad");
+  for (const char* t : {"a", "a.b[2].c", "a[0][1]", "a.2.c", "x_y-z.q[10]"})
+    EXPECT_EQ(KeyPath::parse(KeyPath::parse(t, "w").format(), "w"), KeyPath::parse(t, "w")) << t;
+  EXPECT_EQ(KeyPath::parse("a[0][1]", "w").format(), "a[0][1]");
+  EXPECT_TRUE(KeyPath::parse("vehicle.data.x", "w").startsWith(KeyPath::parse("vehicle.data", "w")));
+  EXPECT_FALSE(KeyPath::parse("vehicle.datax", "w").startsWith(KeyPath::parse("vehicle.data", "w")));
+  EXPECT_EQ(KeyPath::parse("vehicle.data.a[1]", "w").tail(2).under(KeyPath::parse("vehicle.overrides", "w")).format(),
+            "vehicle.overrides.a[1]");
+  EXPECT_EQ(KeyPath::ofKeys({"a", "b"}).child("c").format(), "a.b.c");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("a..b", "f.json: set"); }),
+            "f.json: set: key path 'a..b': empty part (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("a[x]", "w"); }),
+            "w: key path 'a[x]': index [x] is not a number (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("a[1", "w"); }), "w: key path 'a[1': unclosed or empty index (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("[1]", "w"); }), "w: key path '[1]': an index must follow a key (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("a[1]b", "w"); }), "w: key path 'a[1]b': text after an index (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("a.", "w"); }), "w: key path 'a.': ends with '.' (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("a b", "w"); }), "w: key path 'a b': character ' ' (expected e.g. a.b[2].c)");
+  EXPECT_EQ(errorOf([] { KeyPath::parse("", "w"); }), "w: key path '': empty (expected e.g. a.b[2].c)");
+}
+
+TEST(KeyPath, FindsAndSetsByIndexOrNameWithOneErrorFormat) {
+  Json j = R"({"plugins": [{"name": "a", "steps": [{"v": 1}, {"v": 2}]}, {"name": "7", "v": 3}],
+               "out": {"chassis.yaw_rad": 0.5, "chassis": {"x": 1}}, "n": 4})"_json;
+  auto find = [&](const char* t) { return KeyPath::parse(t, "w").find(j); };
+  EXPECT_EQ(*find("plugins.a.steps[1].v"), 2);
+  EXPECT_EQ(*find("plugins.a.steps.1.v"), 2);   // digits at an array: an index
+  EXPECT_EQ(*find("plugins[1].v"), 3);
+  EXPECT_EQ(*find("plugins.1.v"), 3);           // ... not the element named "7"
+  EXPECT_EQ(*find("out.chassis.yaw_rad"), 0.5);  // a key with a dot: the longest key wins
+  EXPECT_EQ(*find("out.chassis.x"), 1);
+  EXPECT_EQ(find("plugins.a.steps[2]"), nullptr);
+  EXPECT_EQ(find("plugins.b"), nullptr);
+  EXPECT_EQ(find("n.x"), nullptr);
+  EXPECT_EQ(find("out[0]"), nullptr);
+
+  KeyPath::parse("plugins.a.steps[0].v", "w").set(j, 1.5, "w");
+  KeyPath::parse("plugins.1.new.deep", "w").set(j, "x", "w");  // missing keys are created
+  EXPECT_EQ(j["plugins"][0]["steps"][0]["v"], 1.5);
+  EXPECT_EQ(j["plugins"][1]["new"]["deep"], "x");
+  EXPECT_EQ(errorOf([&] { KeyPath::parse("plugins.a.steps[5].v", "s.json").set(j, 1, "s.json"); }),
+            "s.json: key path 'plugins.a.steps[5].v': plugins.a.steps has 2 elements, no [5]");
+  EXPECT_EQ(errorOf([&] { KeyPath::parse("plugins.b.v", "s.json").get(j, "s.json"); }),
+            "s.json: key path 'plugins.b.v': plugins has no element named 'b'");
+  EXPECT_EQ(errorOf([&] { KeyPath::parse("n.x", "s.json").set(j, 1, "s.json"); }),
+            "s.json: key path 'n.x': n is 4, not an object or array");
+  EXPECT_EQ(errorOf([&] { KeyPath::parse("out.nothing", "s.json").get(j, "s.json"); }),
+            "s.json: key path 'out.nothing': out has no key 'nothing'");
+  EXPECT_EQ(errorOf([&] { KeyPath::parse("out[0]", "s.json").set(j, 1, "s.json"); }),
+            "s.json: key path 'out[0]': out is an object, not an array: no [0]");
+}
+
+// --set with an index into a steering command's "steps": the changed step
+// reaches the built plugin (its command at the end is the sum of the steps).
+TEST(Override, IndexIntoAnArrayReachesTheBuiltPlugin) {
+  const SceneDescription s = smallScene(R"({
+    "plugins": [
+      {"type": "steering", "name": "front_steer", "attach": "front_axle",
+       "command": {"type": "steps", "steps": [{"start_time_s": 0.0, "duration_s": 0.05, "change_rad": 0.02},
+                                              {"start_time_s": 0.08, "duration_s": 0.05, "change_rad": 0.01}]}},
+      {"type": "speed_hold", "name": "speed_hold", "attach": "chassis", "speed_m_s": 10}],
+    "outputs": ["chassis.yaw_rate_rad_s", "front_steer.command_rad"]})"_json);
+  const Json base = runScene(s);
+  EXPECT_DOUBLE_EQ(base["final"]["front_steer.command_rad"].get<double>(), 0.02 + 0.01);
+  const SceneDescription changed =
+      s.withOverrides({Override::parse("plugins.front_steer.command.steps[1].change_rad=0.04")});
+  EXPECT_EQ(changed.json()["plugins"][0]["command"]["steps"][1]["change_rad"], 0.04);
+  const Json run = runScene(changed);
+  EXPECT_DOUBLE_EQ(run["final"]["front_steer.command_rad"].get<double>(), 0.02 + 0.04);
+  EXPECT_GT(std::abs(run["final"]["chassis.yaw_rate_rad_s"].get<double>()),
+            std::abs(base["final"]["chassis.yaw_rate_rad_s"].get<double>()));
+  EXPECT_EQ(errorOf([&] { s.withOverrides({Override::parse("plugins.front_steer.command.steps[5].change_rad=0.04")}); }),
+            "small.json: key path 'plugins.front_steer.command.steps[5].change_rad': "
+            "plugins.front_steer.command.steps has 2 elements, no [5]");
+  EXPECT_EQ(errorOf([&] { Override::parse("plugins.front_steer..x=1"); }),
+            "--set 'plugins.front_steer..x=1': key path 'plugins.front_steer..x': empty part (expected e.g. a.b[2].c)");
+}
+
+// A sensitivity design parameter with an index: its nominal is read and each
+// design is built through the same KeyPath (the steering command's steps[1]).
+TEST(SceneDesign, ParameterWithAnIndexIsReadAndSet) {
+  const SceneDescription s = smallScene(R"({
+    "plugins": [
+      {"type": "steering", "name": "front_steer", "attach": "front_axle",
+       "command": {"type": "steps", "steps": [{"start_time_s": 0.0, "duration_s": 0.05, "change_rad": 0.02},
+                                              {"start_time_s": 0.08, "duration_s": 0.05, "change_rad": 0.01}]}},
+      {"type": "speed_hold", "name": "speed_hold", "attach": "chassis", "speed_m_s": 10}],
+    "outputs": ["front_steer.command_rad"]})"_json);
+  const std::string path = "plugins.front_steer.command.steps[1].change_rad";
+  const auto params = SceneDesign::parametersOf(s, {path});
+  ASSERT_EQ(params.size(), 1u);
+  EXPECT_EQ(params[0].name, path);
+  EXPECT_EQ(params[0].nominal, 0.01);
+  EXPECT_EQ(params[0].scale, 0.01);
+  const SceneDesign design(s, params);
+  const auto inst = design.build({0.04});
+  SimTK::State st = inst->makeInitialState();
+  st.setTime(0.2);  // after both steps
+  EXPECT_DOUBLE_EQ(inst->getScene().evalOutput("front_steer.command_rad", st), 0.02 + 0.04);
+  EXPECT_EQ(errorOf([&] { SceneDesign::parametersOf(s, {"plugins.front_steer.command.steps[2].change_rad"}); }),
+            "small.json: sensitivity parameter: key path 'plugins.front_steer.command.steps[2].change_rad': "
+            "plugins.front_steer.command.steps has 2 elements, no [2]");
 }
 
 TEST(Registry, EveryKindIsRegisteredAndDocumented) {
@@ -339,6 +453,39 @@ TEST(SceneAnalyses, StaticEquilibriumTireCarriesWeightPlusBodyForce) {
   EXPECT_NEAR(pushed["equilibrium"]["tire.Fz_N"].get<double>(), mg + 300, 1e-5);
   EXPECT_EQ(pushed["equilibrium"]["push.Fz_N"].get<double>(), -300);
   EXPECT_LT(pushed["equilibrium"]["chassis.z_m"].get<double>(), plain["equilibrium"]["chassis.z_m"].get<double>());
+}
+
+// The libraries' diagnostics go to the log sink the program installs
+// (vdyn/core/log.h), never to stderr by themselves, and do not change results:
+// the static equilibrium's Newton iterations are logged at debug level only
+// while a sink is installed, and the equilibrium is the same bit for bit.
+TEST(Log, SinkReceivesDiagnosticsAndResultsDoNotChange) {
+  const SceneDescription s = SceneDescription::fromJson(R"({
+      "vehicle": {"type": "quarter_car", "data": "quarter_car.json"},
+      "analysis": {"type": "static_equilibrium", "ineffective_bodies": ["wheel"]}})"_json,
+                                                        "qc.json", standardRegistry());
+  EXPECT_FALSE(logEnabled(LogLevel::Debug));  // the default: no sink
+  const Json quiet = runScene(s);
+  std::vector<std::string> lines;
+  std::mutex m;
+  setLogSink([&](LogLevel level, const std::string& text) {
+    std::lock_guard<std::mutex> lock(m);
+    lines.push_back(std::string(logLevelName(level)) + " " + text);
+  });
+  EXPECT_TRUE(logEnabled(LogLevel::Debug));
+  const Json logged = runScene(s);
+  setLogSink(nullptr);
+  EXPECT_FALSE(logEnabled(LogLevel::Debug));
+  ASSERT_FALSE(lines.empty());
+  EXPECT_EQ(lines[0].rfind("debug equilibrium: iteration 0 alpha ", 0), 0u) << lines[0];
+  EXPECT_EQ(logged["equilibrium"], quiet["equilibrium"]);
+  const std::size_t n = lines.size();
+  runScene(s);
+  EXPECT_EQ(lines.size(), n);  // removed: nothing more arrives
+  setLogSink([&](LogLevel, const std::string& text) { lines.push_back(text); }, LogLevel::Warning);
+  EXPECT_FALSE(logEnabled(LogLevel::Debug));  // below the minimum
+  setLogSink(nullptr);
+  EXPECT_EQ(logFormat("%d %.3f %s", 7, 0.5, "x"), "7 0.500 x");
 }
 
 // Continuation in the speed hold's adjustable speed finds, at its first value,

@@ -175,6 +175,40 @@ TEST(Sensitivity, MixedCarriesAuxiliaryStates) {
   EXPECT_EQ(withZ.dpsi_db.size(), 3u);
 }
 
+// The mixed method's "refinement" setting: uniform (every node interval
+// bisected each pass, the default) and adaptive (only those with a large
+// interpolation indicator) both meet the tolerance against the closed form,
+// on different node sets.
+TEST(Sensitivity, MixedRefinementUniformAndAdaptive) {
+  const SensitivityProblem p = oscillatorProblem();
+  const ClosedForm cf = closedForm(1, 100, 4);
+  SensitivitySettings set;
+  set.tolerance = 1e-6;
+  EXPECT_EQ(set.refinement, MixedRefinement::Uniform);
+  const SensitivityResult uniform = makeSensitivityMethod("mixed", set)->compute(p);
+  set.refinement = MixedRefinement::Adaptive;
+  const SensitivityResult adaptive = makeSensitivityMethod("mixed", set)->compute(p);
+  ASSERT_EQ(uniform.dpsi_db.size(), 3u);
+  ASSERT_EQ(adaptive.dpsi_db.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_LT(std::abs(uniform.dpsi_db[i] - cf.d[i]) / std::abs(cf.d[i]), 1e-5) << i;
+    EXPECT_LT(std::abs(adaptive.dpsi_db[i] - cf.d[i]) / std::abs(cf.d[i]), 1e-5) << i;
+    EXPECT_NEAR(adaptive.dpsi_db[i], uniform.dpsi_db[i], 2e-5 * std::abs(cf.d[i])) << i;
+  }
+  std::printf("  uniform: %d nodes, %d residual evaluations; adaptive: %d nodes, %d residual evaluations\n",
+              uniform.grid_points, uniform.residual_evaluations, adaptive.grid_points, adaptive.residual_evaluations);
+  EXPECT_NE(uniform.residual_evaluations, adaptive.residual_evaluations);
+  EXPECT_NE(uniform.grid_points, adaptive.grid_points);
+  EXPECT_EQ(mixedRefinementFromName("adaptive", "w"), MixedRefinement::Adaptive);
+  EXPECT_EQ(mixedRefinementFromName("uniform", "w"), MixedRefinement::Uniform);
+  try {
+    mixedRefinementFromName("sometimes", "s.json: analysis.refinement");
+    ADD_FAILURE() << "no error";
+  } catch (const Error& e) {
+    EXPECT_STREQ(e.what(), "s.json: analysis.refinement: expected uniform or adaptive, got 'sometimes'");
+  }
+}
+
 QuarterCarParams relaxationQuarterCar() {
   QuarterCarParams q = QuarterCarParams::fromFile("quarter_car.json");
   q.tire.relaxation_length_longitudinal_m = 0.25;

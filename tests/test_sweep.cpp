@@ -11,6 +11,8 @@
 #include <sstream>
 #include <thread>
 
+#include "vdyn/core/key_path.h"
+#include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 
 using namespace vdyn;
@@ -152,7 +154,7 @@ TEST(SweepFile, StrictKeysAndNamedErrors) {
                      "ranges": {"k": [2, 1]}}}]})"),
             "my.sweep.json: variations[0].monte_carlo.ranges.k: expected min < max, got [2,1]");
   EXPECT_EQ(load(R"({"scene": "s.json", "variations": [{"list": [{"a..b": 1}]}]})"),
-            "my.sweep.json: variations[0].list[0]: 'a..b' is not a key path (empty segment; expected e.g. a.b[2].c)");
+            "my.sweep.json: variations[0].list[0]: key path 'a..b': empty part (expected e.g. a.b[2].c)");
   EXPECT_EQ(load(R"({"scene": "s.json", "variations": [{"grid": [{"key": "a", "values": [1]},
                                                                {"key": "a", "values": [2]}]}]})"),
             "my.sweep.json: variations[0].grid[1].key: key 'a' is varied twice in this block");
@@ -278,6 +280,7 @@ TEST(SweepRunner, ResumeSkipsRunsInTheJournal) {
 }
 
 TEST(SweepFile, SummaryPathsAndPlots) {
+  auto findJsonPath = [](const Json& j, const std::string& path) { return KeyPath::parse(path, "collect").find(j); };
   const Json summary = Json::parse(R"({"a": {"b": [1, {"c": 2.5}]},
                                        "plugins": [{"name": "front_steer", "x": 3}, {"name": "rear", "x": 4}]})");
   EXPECT_EQ(*findJsonPath(summary, "a.b[1].c"), 2.5);
@@ -308,4 +311,35 @@ TEST(SweepFile, SummaryPathsAndPlots) {
             "p.json: plots[0].y: 'z' is neither a varied key nor a collected path; columns: k, y");
   EXPECT_EQ(errorOf([&] { load(R"({"png": "out/y.png", "x": "k", "y": "y"})"); }),
             "p.json: plots[0].png: expected a file name ending in .png (no folder), got \"out/y.png\"");
+}
+
+// A sweep key with an index (a steering command's steps[1]) and a collected
+// path with one: both go through KeyPath (parse when the sweep is read, set by
+// the --set override each run applies, find when the value is collected).
+TEST(SweepFile, KeysAndCollectedPathsWithAnIndex) {
+  const Json scene = R"({"plugins": [{"name": "front_steer", "command": {"steps": [{"change_rad": 0.02},
+                                                                                  {"change_rad": 0.01}]}}]})"_json;
+  const SweepDescription d = SweepDescription::fromJson(Json::parse(R"({"scene": "s.json",
+      "variations": [{"grid": [{"key": "plugins.front_steer.command.steps[1].change_rad", "values": [0.03, 0.05]}]}],
+      "collect": ["plugins.front_steer.command.steps[1].change_rad", "plugins[0].command.steps.0.change_rad"]})"),
+                                                        "k.json:", "");
+  const SweepResult r = runSweep(
+      d,
+      [&](const SweepDescription&, const Variation& v) {
+        Json j = scene;
+        for (const auto& st : v.settings) applyOverride(j, Override{st.key, st.value}, "s.json");
+        return j;
+      },
+      SweepOptions{});
+  ASSERT_EQ(r.rows.size(), 2u);
+  for (std::size_t i = 0; i < 2; ++i) {
+    ASSERT_TRUE(r.rows[i].ok) << r.rows[i].reason;
+    EXPECT_EQ(r.rows[i].values[0], i == 0 ? 0.03 : 0.05);
+    EXPECT_EQ(r.rows[i].values[1], 0.02);
+  }
+  EXPECT_EQ(errorOf([] {
+              SweepDescription::fromJson(Json::parse(R"({"scene": "s.json", "variations": [{"list": [{"a[x]": 1}]}]})"),
+                                         "k.json:", "");
+            }),
+            "k.json: variations[0].list[0]: key path 'a[x]': index [x] is not a number (expected e.g. a.b[2].c)");
 }

@@ -1,6 +1,7 @@
 #include "vdyn/core/equilibrium.h"
 
 #include "vdyn/core/euler_state.h"
+#include "vdyn/core/log.h"
 
 #include <algorithm>
 #include <cstdio>
@@ -64,7 +65,6 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
            (mp == 0 || r.tail(mp).lpNorm<Eigen::Infinity>() <= opt.constraint_tolerance);
   };
 
-  const bool debug = std::getenv("VDYN_DEBUG_EQUILIBRIUM") != nullptr;
   Eigen::VectorXd x(n);
   for (int i = 0; i < nq; ++i) x[i] = se.getQ()[qs[i]];
   x.tail(mp).setZero();
@@ -91,9 +91,9 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
       decreased = rn.allFinite() && merit(rn) < m0;
       if (!decreased) alpha *= 0.5;
     }
-    if (debug)
-      std::fprintf(stderr, "equilibrium: iteration %d alpha %g merit %g -> %g\n", res.iterations, alpha, m0,
-                   merit(rn));
+    if (logEnabled(LogLevel::Debug))
+      logMessage(LogLevel::Debug, logFormat("equilibrium: iteration %d alpha %g merit %g -> %g", res.iterations,
+                                            alpha, m0, merit(rn)));
     if (!decreased) break;  // no descent: report below
     x = xn;
     r = rn;

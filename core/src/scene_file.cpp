@@ -7,6 +7,7 @@
 #include <iomanip>
 #include <sstream>
 
+#include "vdyn/core/key_path.h"
 #include "vdyn/core/plugin_library.h"
 
 namespace vdyn {
@@ -38,6 +39,7 @@ Override Override::parse(const std::string& text, const std::string& option) {
     throw Error(option + " '" + text + "': expected key.path=value");
   Override o;
   o.key_path = text.substr(0, eq);
+  KeyPath::parse(o.key_path, option + " '" + text + "'");  // a malformed path is named here
   const std::string v = text.substr(eq + 1);
   // nan, inf and numbers beyond a double are named here: silently turned into
   // a string (or the JSON library's raw text) they would name nothing.
@@ -57,52 +59,7 @@ Override Override::parse(const std::string& text, const std::string& option) {
 }
 
 void applyOverride(Json& scene, const Override& o, const std::string& where) {
-  std::vector<std::string> parts;
-  std::string item;
-  for (char c : o.key_path + ".") {
-    if (c == '.') {
-      if (item.empty()) throw Error(where + ": override '" + o.key_path + "': empty key in the path");
-      parts.push_back(item);
-      item.clear();
-    } else {
-      item += c;
-    }
-  }
-  Json* node = &scene;
-  std::string done;
-  for (std::size_t i = 0; i < parts.size(); ++i) {
-    const std::string& p = parts[i];
-    const bool last = i + 1 == parts.size();
-    Json* next = nullptr;
-    if (node->is_array()) {
-      const bool numeric = p.find_first_not_of("0123456789") == std::string::npos;
-      if (numeric) {
-        const std::size_t k = std::stoul(p);
-        if (k >= node->size())
-          throw Error(where + ": override '" + o.key_path + "': " + (done.empty() ? "" : done + " ") + "has " +
-                      std::to_string(node->size()) + " elements, no [" + p + "]");
-        next = &(*node)[k];
-      } else {
-        for (auto& e : *node)
-          if (e.is_object() && e.contains("name") && e["name"] == p) next = &e;
-        if (!next)
-          throw Error(where + ": override '" + o.key_path + "': " + (done.empty() ? "the array" : done) +
-                      " has no element named '" + p + "'");
-      }
-      if (last) *next = o.value;
-    } else if (node->is_object() || node->is_null()) {
-      if (last) {
-        (*node)[p] = o.value;
-        return;
-      }
-      next = &(*node)[p];
-    } else {
-      throw Error(where + ": override '" + o.key_path + "': " + done + " is " + node->dump() +
-                  ", not an object or array");
-    }
-    done += (done.empty() ? "" : ".") + p;
-    node = next;
-  }
+  KeyPath::parse(o.key_path, where).set(scene, o.value, where);
 }
 
 // ---------------------------------------------------------------------------

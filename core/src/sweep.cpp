@@ -1,5 +1,7 @@
 #include "vdyn/core/sweep.h"
 
+#include "vdyn/core/key_path.h"
+
 #include <algorithm>
 #include <cassert>
 #include <cctype>
@@ -88,34 +90,8 @@ long long requireCount(const Json& j, const std::string& where, long long max = 
   return j.get<long long>();
 }
 
-/// A key path: segments [A-Za-z0-9_-]+ separated by '.', each optionally followed by [n].
-void validatePath(const std::string& path, const std::string& where) {
-  auto bad = [&](const std::string& why) {
-    throw Error(where + ": '" + path + "' is not a key path (" + why + "; expected e.g. a.b[2].c)");
-  };
-  if (path.empty()) bad("empty");
-  bool segmentHasName = false;
-  for (std::size_t i = 0; i < path.size(); ++i) {
-    const char c = path[i];
-    if (std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-') {
-      segmentHasName = true;
-    } else if (c == '.') {
-      if (!segmentHasName) bad("empty segment");
-      segmentHasName = false;
-    } else if (c == '[') {
-      if (!segmentHasName) bad("an index must follow a name");
-      const std::size_t close = path.find(']', i);
-      if (close == std::string::npos || close == i + 1) bad("unclosed or empty index");
-      for (std::size_t k = i + 1; k < close; ++k)
-        if (!std::isdigit(static_cast<unsigned char>(path[k]))) bad("index is not a number");
-      i = close;
-      if (i + 1 < path.size() && path[i + 1] != '.' && path[i + 1] != '[') bad("text after an index");
-    } else {
-      bad(std::string("character '") + c + "'");
-    }
-  }
-  if (!segmentHasName && path.back() != ']') bad("ends with '.'");
-}
+/// Checks that `path` is a KeyPath (the error names `where` and the path).
+void validatePath(const std::string& path, const std::string& where) { KeyPath::parse(path, where); }
 
 std::uint64_t splitmix64(std::uint64_t& x) {
   std::uint64_t z = (x += 0x9e3779b97f4a7c15ULL);
@@ -497,65 +473,11 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
 }
 
 // --- summaries and rows ---------------------------------------------------------
-const Json* findJsonPath(const Json& j, const std::string& path) {
-  const Json* cur = &j;
-  std::size_t i = 0;
-  auto isIndex = [](const std::string& t) {
-    return !t.empty() && t.size() < 10 && std::all_of(t.begin(), t.end(), [](char c) { return c >= '0' && c <= '9'; });
-  };
-  while (i < path.size()) {
-    if (path[i] == '.') ++i;
-    if (i < path.size() && path[i] == '[') {
-      const std::size_t close = path.find(']', i);
-      if (close == std::string::npos) return nullptr;
-      const std::string t = path.substr(i + 1, close - i - 1);
-      if (!isIndex(t) || !cur->is_array() || std::stoul(t) >= cur->size()) return nullptr;
-      cur = &(*cur)[std::stoul(t)];
-      i = close + 1;
-      continue;
-    }
-    std::size_t end = path.find_first_of(".[", i);
-    std::string name = path.substr(i, end == std::string::npos ? std::string::npos : end - i);
-    if (cur->is_object()) {
-      // Keys may hold dots themselves (output names: "steady.chassis.yaw_rate_rad_s"
-      // is key "chassis.yaw_rate_rad_s" under "steady"): the longest key that matches wins.
-      auto it = cur->end();
-      for (std::size_t e = path.size();; e = path.rfind('.', e - 1)) {
-        const std::size_t stop = std::min(e, path.find('[', i));
-        if (stop > i && (it = cur->find(path.substr(i, stop - i))) != cur->end()) {
-          end = stop == path.size() ? std::string::npos : stop;
-          break;
-        }
-        if (e == std::string::npos || e <= i) break;
-      }
-      if (it == cur->end()) return nullptr;
-      cur = &*it;
-      i = end == std::string::npos ? path.size() : end;
-      continue;
-    }
-    i = end == std::string::npos ? path.size() : end;
-    if (cur->is_array()) {
-      const Json* found = nullptr;
-      if (isIndex(name)) {
-        if (std::stoul(name) < cur->size()) found = &(*cur)[std::stoul(name)];
-      } else {
-        for (const Json& e : *cur)
-          if (e.is_object() && e.contains("name") && e["name"] == name) found = &e;
-      }
-      if (!found) return nullptr;
-      cur = found;
-    } else {
-      return nullptr;
-    }
-  }
-  return cur;
-}
-
 void collectValues(const SweepDescription& d, SweepRow& row) {
   row.values.assign(d.collect.size(), Json());
   if (!row.ok) return;
   for (std::size_t k = 0; k < d.collect.size(); ++k) {
-    const Json* v = findJsonPath(row.summary, d.collect[k]);
+    const Json* v = KeyPath::parse(d.collect[k], "collect").find(row.summary);
     if (!v) {
       std::string known;
       if (row.summary.is_object())

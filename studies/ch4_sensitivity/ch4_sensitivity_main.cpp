@@ -102,6 +102,7 @@ int main(int argc, char** argv) {
     set.tolerance = mixed.number("tolerance");
     set.initial_intervals = mixed.integer("initial_intervals");
     set.max_levels = mixed.integer("max_levels");
+    set.refinement = mixedRefinementFromName(mixed.stringOr("refinement", "uniform"), mixed.at("refinement"));
     set.reference_accuracy = ref.number("accuracy");
     set.reference_perturbation = ref.number("perturbation");
     data.requireAllKeysRead();

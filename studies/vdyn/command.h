@@ -19,7 +19,7 @@ struct Command {
   int (*main)(const std::vector<std::string>& args);
 };
 
-/// Adds --plugin PATH (repeatable) and --help.
+/// Adds --plugin PATH (repeatable), --verbose (a stderr log sink, installed by parseArgs) and --help.
 void addCommonOptions(study::po::options_description& opts);
 /// Parses `args` against `opts` with `positional` names (each once, in order);
 /// on --help prints the usage and returns false.

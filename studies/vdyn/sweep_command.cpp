@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "command.h"
+#include "vdyn/core/key_path.h"
 #include "vdyn/core/plot.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
@@ -34,9 +35,12 @@ std::vector<Override> toOverrides(const std::vector<SweepSetting>& settings) {
   return o;
 }
 
+/// The last key of a (checked) key path with any indices after it: "steps[1]" of "a.steps[1]".
 std::string lastSegment(const std::string& path) {
-  const auto p = path.find_last_of('.');
-  return p == std::string::npos ? path : path.substr(p + 1);
+  const KeyPath k = KeyPath::parse(path, "sweep");
+  std::size_t last = k.parts().size() - 1;
+  while (last > 0 && k.parts()[last].bracketed) --last;
+  return k.tail(last).format();
 }
 
 /// Renders the sweep file's plots from results.csv with gnuplot (script kept as <png>.gp).

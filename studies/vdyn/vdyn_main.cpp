@@ -9,6 +9,7 @@
 #include <iostream>
 
 #include "command.h"
+#include "vdyn/core/log.h"
 #include "vdyn/core/plugin_library.h"
 #include "vdyn/vehicles/standard_registry.h"
 
@@ -41,6 +42,7 @@ const Command& command(const std::string& name) {
 
 void addCommonOptions(study::po::options_description& opts) {
   opts.add_options()("help,h", "print this help and exit")(
+      "verbose", "print the libraries' diagnostics (solver iterations, sensitivity passes) to stderr")(
       "plugin", study::po::value<std::vector<std::string>>()->composing(),
       "load an out-of-tree plugin library (repeatable; see vdyn/core/plugin_library.h)");
 }
@@ -56,6 +58,8 @@ bool parseArgs(const Command& cmd, const std::vector<std::string>& args, study::
   } catch (const po::error& e) {
     throw Error(std::string("bad command line: ") + e.what() + " (see vdyn " + cmd.name + " --help)");
   }
+  // The log sink is installed once, here, before anything runs (vdyn/core/log.h).
+  if (vm.count("verbose")) setLogSink(stderrLogSink());
   if (vm.count("help")) {
     std::cout << "vdyn " << cmd.usage << "\n  " << cmd.summary << "\n\n" << opts << std::endl;
     return false;

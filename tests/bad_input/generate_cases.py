@@ -187,7 +187,7 @@ for key, bad, text in [
     tag = key.replace('.', '_') + '.' + re.sub(r'[^A-Za-z0-9]', '_', bad)
     add(f'SceneRun.{tag}', 1, text, None, 'vdyn run ' + SC + ' --out {OUT} --set ' + key + '=' + bad)
 add('Scene.SetNoValue', 1, "--set 'analysis.t_end_s': expected key.path=value", None, CHK + 'analysis.t_end_s')
-add('Scene.SetEmptyKey', 1, 'empty key in the path', None, CHK + 'analysis..t_end_s=1')
+add('Scene.SetEmptyKey', 1, 'empty part', None, CHK + 'analysis..t_end_s=1')
 add('Scene.BasedOnCycle', 1, 'based_on', '{"based_on": "case.json"}', 'vdyn check {CASE}')
 add('Scene.Positional', 1, "too many positional options", None, 'vdyn check ' + SC + ' stray')
 

@@ -8,25 +8,22 @@
 #include <cmath>
 
 #include "vdyn/analyses/analyses.h"
+#include "vdyn/core/key_path.h"
 #include "vdyn/sensitivity/sensitivity.h"
 
 namespace vdyn {
 
 namespace {
-constexpr const char* kData = "vehicle.data.";
 
-/// The value at a dotted key path of a JSON object (objects only).
-const Json* at(const Json& j, const std::string& path) {
-  const Json* node = &j;
-  std::size_t start = 0;
-  while (start <= path.size()) {
-    const std::size_t end = std::min(path.find('.', start), path.size());
-    const std::string key = path.substr(start, end - start);
-    if (!node->is_object() || !node->contains(key)) return nullptr;
-    node = &(*node)[key];
-    start = end + 1;
-  }
-  return node;
+/// "vehicle.data": a parameter path under it names a value of the vehicle's
+/// data file (set through the scene's vehicle.overrides).
+const KeyPath& dataPrefix() {
+  static const KeyPath k = KeyPath::parse("vehicle.data", "");
+  return k;
+}
+const KeyPath& overridesPrefix() {
+  static const KeyPath k = KeyPath::parse("vehicle.overrides", "");
+  return k;
 }
 
 class SceneInstance : public DesignInstance {
@@ -43,12 +40,12 @@ class SceneInstance : public DesignInstance {
 
 /// The merge patch `j` as overrides of vehicle.overrides.<path> (objects
 /// descend; any other value is set at its path).
-void flattenPatch(const Json& j, const std::string& prefix, std::vector<Override>& out) {
+void flattenPatch(const Json& j, const KeyPath& prefix, std::vector<Override>& out) {
   if (!j.is_object()) {
-    out.push_back({prefix, j});
+    out.push_back({prefix.format(), j});
     return;
   }
-  for (auto it = j.begin(); it != j.end(); ++it) flattenPatch(it.value(), prefix + "." + it.key(), out);
+  for (auto it = j.begin(); it != j.end(); ++it) flattenPatch(it.value(), prefix.child(it.key()), out);
 }
 
 SceneDesign::SceneDesign(const SceneDescription& scene, const std::vector<DesignParameter>& params)
@@ -64,7 +61,7 @@ SceneDesign::SceneDesign(const SceneDescription& scene, const std::vector<Design
                 std::to_string(paths_.size()) + " key paths");
   if (heldData.is_object())
     for (auto it = heldData.begin(); it != heldData.end(); ++it)
-      flattenPatch(it.value(), "vehicle.overrides." + it.key(), held_);
+      flattenPatch(it.value(), overridesPrefix().child(it.key()), held_);
 }
 
 std::vector<DesignParameter> SceneDesign::parametersOf(const SceneDescription& scene,
@@ -72,24 +69,25 @@ std::vector<DesignParameter> SceneDesign::parametersOf(const SceneDescription& s
   std::unique_ptr<Json> data;
   std::vector<DesignParameter> out;
   for (const auto& path : keyPaths) {
+    const std::string where = (scene.path().empty() ? std::string("scene") : scene.path()) + ": sensitivity parameter";
+    const KeyPath key = KeyPath::parse(path, where);
     const Json* v = nullptr;
-    if (path.rfind(kData, 0) == 0) {
-      const std::string rest = path.substr(std::string(kData).size());
-      const Json& sj = scene.json();
-      if (sj.contains("vehicle") && sj["vehicle"].contains("overrides")) v = at(sj["vehicle"]["overrides"], rest);
+    if (key.startsWith(dataPrefix())) {
+      const KeyPath rest = key.tail(dataPrefix().parts().size());
+      const Json* ov = overridesPrefix().find(scene.json());
+      if (ov) v = rest.find(*ov);
       if (!v) {
         if (!data) {
-          const std::string file = scene.resolve(sj.at("vehicle").at("data").get<std::string>());
+          const std::string file = scene.resolve(scene.json().at("vehicle").at("data").get<std::string>());
           data = std::make_unique<Json>(ParamReader::fromFile(file).json());
         }
-        v = at(*data, rest);
+        v = &rest.get(*data, where + " (vehicle.data.<key path> names a value of the vehicle data file)");
       }
     } else {
-      v = at(scene.json(), path);
+      v = &key.get(scene.json(), where);
     }
-    if (!v || !v->is_number())
-      throw Error("sensitivity parameter '" + path + "': " + (v ? "not a number: " + v->dump() : "no such value") +
-                  " in the scene (vehicle.data.<key path> names a value of the vehicle data file)");
+    if (!v->is_number())
+      throw Error(where + ": key path '" + path + "': " + v->dump() + " is not a number");
     const double nominal = v->get<double>();
     DesignParameter p;
     p.name = path;
@@ -105,10 +103,10 @@ std::vector<DesignParameter> SceneDesign::parametersOf(const SceneDescription& s
 std::unique_ptr<DesignInstance> SceneDesign::DoBuild(const std::vector<double>& values) const {
   std::vector<Override> overrides = held_;  // held first: a parameter that is a held value wins
   for (std::size_t i = 0; i < values.size(); ++i) {
-    const std::string& path = paths_[i];
-    const std::string target =
-        path.rfind(kData, 0) == 0 ? "vehicle.overrides." + path.substr(std::string(kData).size()) : path;
-    overrides.push_back({target, values[i]});
+    const KeyPath key = KeyPath::parse(paths_[i], "sensitivity parameter");
+    const KeyPath target =
+        key.startsWith(dataPrefix()) ? key.tail(dataPrefix().parts().size()).under(overridesPrefix()) : key;
+    overrides.push_back({target.format(), values[i]});
   }
   return std::make_unique<SceneInstance>(scene_.withOverrides(overrides).build());
 }
@@ -130,6 +128,7 @@ struct SensitivityEntry {
   IntegratorSettings integrator;
   SensitivitySettings settings;
   double tolerance = SensitivitySettings{}.tolerance;
+  std::string refinement = "uniform";
   double perturbation = 0;
 };
 
@@ -175,6 +174,9 @@ const FieldTable<SensitivityEntry>& sensitivityFields() {
                     if (r.has("integrator")) e.integrator = IntegratorSettings::fromParams(r.child("integrator"));
                   })
           .number("tolerance", &E::tolerance, "", "mixed: relative tolerance on the error estimate")
+          .string("refinement", &E::refinement,
+                  "mixed: node intervals bisected each pass: uniform (all) | adaptive (those whose interpolation "
+                  "indicator is >= 0.1 of the largest)")
           .number("perturbation", &E::perturbation, "", "finite differences: relative step (0 = from the accuracy)");
   return t;
 }
@@ -222,6 +224,7 @@ class SensitivityAnalysis : public Analysis {
       if (!registry.hasChoice("sensitivity_method", m)) makeSensitivityMethod(m, {}, &registry);
     requirePositive(e_.t_end_s, r.at("t_end_s"));
     e_.settings.tolerance = e_.tolerance;
+    e_.settings.refinement = mixedRefinementFromName(e_.refinement, r.at("refinement"));
     e_.settings.perturbation = e_.perturbation;
   }
 

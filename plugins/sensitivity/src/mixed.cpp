@@ -3,11 +3,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <map>
 
 #include "methods.h"
+#include "vdyn/core/log.h"
 #include "vdyn/core/simulation.h"
 
 namespace vdyn {
@@ -175,6 +174,18 @@ MatrixXd sensitivityMatrix(const ResidualJacobians& J, const Eigen::PartialPivLU
 }
 
 // ---------------------------------------------------------------------------
+// The mixed method in its parts, in the order DoCompute uses them:
+//   NominalRun              the nominal simulation: psi and its steps (the
+//                           coefficient nodes are chosen among them);
+//   PerturbedModels         one model rebuilt at b + delta e_i per parameter
+//                           (for R_b, a_b) and the initial sensitivity x_b(0);
+//   CoefficientNodes        the coefficients A, B, y, y_x, y_b at a nominal
+//                           step, computed once and kept for every pass;
+//   SensitivityIntegration  the coefficients interpolated between the nodes
+//                           and x_b' = A x_b + B integrated by two-stage Radau
+//                           IIA with the cost's derivative, substeps doubled
+//                           until their step-doubling estimate is small;
+//   refineNodes             the next pass's nodes (bisection, then balancing).
 class MixedMethod : public SensitivityMethod {
  public:
   explicit MixedMethod(SensitivitySettings s) : SensitivityMethod("mixed", s) {}
@@ -201,131 +212,169 @@ int integralZIndex(const Scene& sc, IntegralHandle h, const SimTK::State& s) {
               " z of the scene");
 }
 
-SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
-  const auto wall0 = std::chrono::steady_clock::now();
-  const SensitivitySettings& set = settings();
-  const auto idx = p.parameterIndices();
-  const int r = static_cast<int>(idx.size());
-  const auto& params = p.model->getParameters();
-  const std::vector<double> b0 = p.model->getNominalValues();
-  const CostFunctional& cost = p.cost;
-  const bool integral = cost.kind == CostKind::IntegralOfSquare;
+/// The nominal run: the model built at the nominal design b0, simulated over
+/// [t0, t0 + T] (Simbody, error-controlled) with every step's (t, q, u, z)
+/// stored, and the cost psi of the run. The state x = (q, u, z) of the
+/// sensitivity system is in Euler angles; its z are the auxiliary first-order
+/// states (tire relaxation deflections), without the cost integral's z (the
+/// integral's sensitivity is the quadrature of (4.47)).
+struct NominalRun {
+  NominalRun(const SensitivityProblem& p, const std::vector<double>& b0)
+      : instance(p.model->build(b0)), scene(instance->updScene()), out(scene.getOutput(p.cost.output)) {
+    const CostFunctional& cost = p.cost;
+    const bool integral = cost.kind == CostKind::IntegralOfSquare;
+    IntegralHandle psiHandle;
+    if (integral) psiHandle = scene.addIntegralOfSquare(cost.output);
+    start = toEulerAngles(scene, instance->makeInitialState());
+    const SimTK::MultibodySystem& sys = scene.getSystem();
+    const int zPsi = integral ? integralZIndex(scene, psiHandle, start) : -1;
+    for (int j = 0; j < start.getNZ(); ++j)
+      if (j != zPsi) zi.push_back(j);
+    nq = start.getNQ();
+    nu = start.getNU();
+    nw = static_cast<int>(zi.size());
+    n = nq + nu + nw;
+    t0 = start.getTime();
+    T = p.t_end_s;
+    const double tEnd = t0 + T;
+    // Inputs may switch on at t0 (the sine road starts there): coefficients at
+    // the first grid point are the right-hand limits.
+    tiny = 1e-10 * T;
+    stage = out.stage > SimTK::Stage::Dynamics ? out.stage : SimTK::Stage(SimTK::Stage::Dynamics);
 
-  // --- nominal run, its steps stored for interpolation ----------------------
-  auto nominal = p.model->build(b0);
-  Scene& sc = nominal->updScene();
-  const Output out = sc.getOutput(cost.output);
-  IntegralHandle psiHandle;
-  if (integral) psiHandle = sc.addIntegralOfSquare(cost.output);
-  SimTK::State s = toEulerAngles(sc, nominal->makeInitialState());
-  const SimTK::MultibodySystem& sys = sc.getSystem();
-  const SimTK::SimbodyMatterSubsystem& matter = sc.getMatter();
-  // Auxiliary first-order states (tire relaxation deflections) join q and u
-  // in x; the cost integral's z is left out (its sensitivity is the
-  // quadrature of (4.47) below).
-  const int zPsi = integral ? integralZIndex(sc, psiHandle, s) : -1;
-  std::vector<int> zi;
-  for (int j = 0; j < s.getNZ(); ++j)
-    if (j != zPsi) zi.push_back(j);
-  const int nq = s.getNQ(), nu = s.getNU(), nw = static_cast<int>(zi.size()), n = nq + nu + nw;
-  std::vector<int> ziPerturbed(nw);  // the perturbed models carry no cost integral
-  for (int j = 0; j < nw; ++j) ziPerturbed[j] = j;
-  const double t0 = s.getTime(), T = p.t_end_s, tEnd = t0 + T;
-  // Inputs may switch on at t0 (the sine road starts there): coefficients at
-  // the first grid point are the right-hand limits.
-  const double tiny = 1e-10 * T;
-  const SimTK::Stage stage = out.stage > SimTK::Stage::Dynamics ? out.stage : SimTK::Stage(SimTK::Stage::Dynamics);
-
-  std::vector<Sample> samples;
-  double maxSample = -SimTK::Infinity;
-  auto store = [&](const SimTK::State& st) {
-    sys.realize(st, SimTK::Stage::Acceleration);
-    samples.push_back({st.getTime(), toEigen(st.getQ()), toEigen(st.getU()), toEigen(st.getZ())});
-    if (cost.kind == CostKind::Maximum) maxSample = std::max(maxSample, out.eval(st));
-  };
-  {
-    SimTK::State s0 = s;
-    s0.setTime(t0 + tiny);
-    store(s0);
-    samples.back().t = t0;
-  }
-  SimulationSettings sim;
-  sim.t_end_s = tEnd;
-  sim.report_interval_s = 0;
-  sim.integrator = p.integrator;
-  SimTK::State sEnd = s;
-  const auto nominal0 = std::chrono::steady_clock::now();
-  simulate(sc, sEnd, sim, nullptr, store);
-  if (samples.back().t < tEnd - 1e-12 * std::max(1.0, std::abs(tEnd))) store(sEnd);
-  SensitivityResult res;
-  res.nominal_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - nominal0).count();
-  res.simulations = 1;
-  switch (cost.kind) {
-    case CostKind::IntegralOfSquare: res.psi = sc.getIntegral(psiHandle, sEnd); break;
-    case CostKind::Maximum: res.psi = maxSample; break;
-    case CostKind::FinalValue: res.psi = sc.evalOutput(cost.output, sEnd); break;
-  }
-
-  // --- perturbed models: r_b (4.44) and the initial sensitivity -------------
-  std::vector<std::unique_ptr<DesignInstance>> perturbed;
-  std::vector<SimTK::State> pwork;
-  std::vector<double> delta;
-  MatrixXd X0(n, r);
-  for (int c = 0; c < r; ++c) {
-    const int i = idx[c];
-    const double scale = std::max(std::abs(b0[i]), params[i].scale);
-    std::vector<double> b = b0;
-    delta.push_back(kParamStep * scale);
-    b[i] += delta.back();
-    perturbed.push_back(p.model->build(b));
-    const Scene& ps = perturbed.back()->getScene();
-    SimTK::State w = ps.getDefaultState();
-    ps.getMatter().setUseEulerAngles(w, true);
-    ps.getSystem().realizeModel(w);
-    if (w.getNQ() != nq || w.getNU() != nu || w.getNZ() != nw)
-      throw Error("mixed: perturbing " + params[i].name + " changed the state layout (nq, nu, nz)");
-    pwork.push_back(w);
-    // Initial state x(0; b) (e.g. a static equilibrium): central difference.
-    const double h0 = kInitialStep * scale;
-    VectorXd x[2];
-    for (int k = 0; k < 2; ++k) {
-      std::vector<double> bk = b0;
-      bk[i] += k == 0 ? h0 : -h0;
-      auto inst = p.model->build(bk);
-      const SimTK::State sk = toEulerAngles(inst->getScene(), inst->makeInitialState());
-      x[k].resize(n);
-      x[k].head(nq) = toEigen(sk.getQ());
-      x[k].segment(nq, nu) = toEigen(sk.getU());
-      for (int j = 0; j < nw; ++j) x[k][nq + nu + j] = sk.getZ()[j];
+    double maxSample = -SimTK::Infinity;
+    auto store = [&](const SimTK::State& st) {
+      sys.realize(st, SimTK::Stage::Acceleration);
+      samples.push_back({st.getTime(), toEigen(st.getQ()), toEigen(st.getU()), toEigen(st.getZ())});
+      if (cost.kind == CostKind::Maximum) maxSample = std::max(maxSample, out.eval(st));
+    };
+    {
+      SimTK::State s0 = start;
+      s0.setTime(t0 + tiny);
+      store(s0);
+      samples.back().t = t0;
     }
-    X0.col(c) = (x[0] - x[1]) / (2 * h0);
-    if (std::getenv("VDYN_DEBUG_MIXED")) std::fprintf(stderr, "X0 col %d: %g %g\n", c, X0(0, c), X0(n - 1, c));
+    SimulationSettings sim;
+    sim.t_end_s = tEnd;
+    sim.report_interval_s = 0;
+    sim.integrator = p.integrator;
+    SimTK::State sEnd = start;
+    const auto wall0 = std::chrono::steady_clock::now();
+    simulate(scene, sEnd, sim, nullptr, store);
+    if (samples.back().t < tEnd - 1e-12 * std::max(1.0, std::abs(tEnd))) store(sEnd);
+    wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    switch (cost.kind) {
+      case CostKind::IntegralOfSquare: psi = scene.getIntegral(psiHandle, sEnd); break;
+      case CostKind::Maximum: psi = maxSample; break;
+      case CostKind::FinalValue: psi = scene.evalOutput(cost.output, sEnd); break;
+    }
+  }
+  /// Index of the last stored step.
+  long finest() const { return static_cast<long>(samples.size()) - 1; }
+  /// Time of step k from t0.
+  double timeOf(long k) const { return samples[k].t - t0; }
+
+  std::unique_ptr<DesignInstance> instance;
+  Scene& scene;
+  const Output out;          ///< the cost's output (a copy: the integral added after it)
+  SimTK::State start;        ///< initial state, Euler angles
+  std::vector<int> zi;       ///< indices of the auxiliary z among the state's z
+  int nq = 0, nu = 0, nw = 0, n = 0;
+  double t0 = 0, T = 0, tiny = 0;
+  SimTK::Stage stage;        ///< realization stage of a residual evaluation (Dynamics, or the output's)
+  std::vector<Sample> samples;
+  double psi = 0;
+  double wall_time_s = 0;
+};
+
+/// Per parameter b_i: the model rebuilt at b0 + delta_i e_i (delta_i =
+/// kParamStep max(|b_i|, scale_i)), a workspace state of it, and the initial
+/// sensitivity column x_b(0) = dx(0)/db_i, a central difference of the
+/// model's initial state (e.g. its static equilibrium) at kInitialStep.
+struct PerturbedModels {
+  PerturbedModels(const SensitivityProblem& p, const std::vector<int>& idx, const std::vector<double>& b0,
+                  const NominalRun& nom)
+      : X0(nom.n, static_cast<int>(idx.size())) {
+    const auto& params = p.model->getParameters();
+    const int nq = nom.nq, nu = nom.nu, nw = nom.nw, n = nom.n;
+    for (int c = 0; c < static_cast<int>(idx.size()); ++c) {
+      const int i = idx[c];
+      const double scale = std::max(std::abs(b0[i]), params[i].scale);
+      std::vector<double> b = b0;
+      delta.push_back(kParamStep * scale);
+      b[i] += delta.back();
+      models.push_back(p.model->build(b));
+      const Scene& ps = models.back()->getScene();
+      SimTK::State w = ps.getDefaultState();
+      ps.getMatter().setUseEulerAngles(w, true);
+      ps.getSystem().realizeModel(w);
+      if (w.getNQ() != nq || w.getNU() != nu || w.getNZ() != nw)
+        throw Error("mixed: perturbing " + params[i].name + " changed the state layout (nq, nu, nz)");
+      work.push_back(w);
+      const double h0 = kInitialStep * scale;
+      VectorXd x[2];
+      for (int k = 0; k < 2; ++k) {
+        std::vector<double> bk = b0;
+        bk[i] += k == 0 ? h0 : -h0;
+        auto inst = p.model->build(bk);
+        const SimTK::State sk = toEulerAngles(inst->getScene(), inst->makeInitialState());
+        x[k].resize(n);
+        x[k].head(nq) = toEigen(sk.getQ());
+        x[k].segment(nq, nu) = toEigen(sk.getU());
+        for (int j = 0; j < nw; ++j) x[k][nq + nu + j] = sk.getZ()[j];
+      }
+      X0.col(c) = (x[0] - x[1]) / (2 * h0);
+      if (logEnabled(LogLevel::Debug))
+        logMessage(LogLevel::Debug, logFormat("mixed: x_b(0) column %d: %g %g", c, X0(0, c), X0(n - 1, c)));
+    }
   }
 
-  // --- coefficient matrices at grid points (shared by all levels) -----------
-  // Coefficient nodes are steps of the nominal run: their states lie on the
-  // integrator's trajectory (an interpolated state between steps would sit off
-  // the stiff tire modes' slow manifold and make the coefficients rough).
-  const int N0 = set.initial_intervals;
-  const long finest = static_cast<long>(samples.size()) - 1;
-  struct Point {
-    double y = 0;
-    RowVectorXd y_x, y_b;
-    MatrixXd A, B;
-  };
-  std::map<long, Point> points;
-  SimTK::State nomWork = s, colWork = s;
-  auto point = [&](long k) -> const Point& {
-    auto it = points.find(k);
-    if (it != points.end()) return it->second;
-    const double t = k == 0 ? t0 + tiny : samples[k].t;
-    nomWork.setTime(t);
-    for (int i = 0; i < nq; ++i) nomWork.updQ()[i] = samples[k].q[i];
-    for (int i = 0; i < nu; ++i) nomWork.updU()[i] = samples[k].u[i];
-    for (int i = 0; i < nomWork.getNZ(); ++i) nomWork.updZ()[i] = samples[k].z[i];
-    sys.realize(nomWork, SimTK::Stage::Acceleration);
-    const PointJacobians J = evalJacobians(sc, nomWork, colWork, &out, stage, false, zi);
-    res.residual_evaluations += J.evaluations;
+  std::vector<std::unique_ptr<DesignInstance>> models;
+  std::vector<SimTK::State> work;  ///< one workspace state per perturbed model
+  std::vector<double> delta;       ///< the perturbation of each parameter
+  MatrixXd X0;                     ///< initial sensitivity, n x r
+};
+
+/// The coefficients of x_b' = A x_b + B and of the cost's derivative at one
+/// node: the output y, its derivatives y_x (n) and y_b (r).
+struct Point {
+  double y = 0;
+  RowVectorXd y_x, y_b;
+  MatrixXd A, B;
+};
+
+/// The coefficients at nominal steps, each computed on first use and kept
+/// (every pass shares the nodes of the previous ones). At step k: the nominal
+/// state is realized to Acceleration, A = [(N u)_x; U'_x; z'_x] comes from
+/// the forward-difference residual Jacobians (evalJacobians) and the
+/// factorized [M G^T; G 0]; column i of B and y_b are forward differences of
+/// R, a, q', z' and y through perturbed model i at the nominal (q, u, u',
+/// lambda) (4.44). Coefficient nodes are steps of the nominal run: their
+/// states lie on the integrator's trajectory (an interpolated state between
+/// steps would sit off the stiff tire modes' slow manifold and make the
+/// coefficients rough).
+class CoefficientNodes {
+ public:
+  CoefficientNodes(const NominalRun& nom, PerturbedModels& perturbed, const std::string& output)
+      : nom_(nom), perturbed_(perturbed), output_(output), nomWork_(nom.start), colWork_(nom.start) {
+    for (int j = 0; j < nom.nw; ++j) ziPerturbed_.push_back(j);  // the perturbed models carry no cost integral
+  }
+
+  /// The coefficients at nominal step k.
+  const Point& at(long k) {
+    auto it = points_.find(k);
+    if (it != points_.end()) return it->second;
+    const NominalRun& nom = nom_;
+    const int nq = nom.nq, nu = nom.nu, nw = nom.nw, n = nom.n;
+    const int r = static_cast<int>(perturbed_.models.size());
+    const double t = k == 0 ? nom.t0 + nom.tiny : nom.samples[k].t;
+    nomWork_.setTime(t);
+    for (int i = 0; i < nq; ++i) nomWork_.updQ()[i] = nom.samples[k].q[i];
+    for (int i = 0; i < nu; ++i) nomWork_.updU()[i] = nom.samples[k].u[i];
+    for (int i = 0; i < nomWork_.getNZ(); ++i) nomWork_.updZ()[i] = nom.samples[k].z[i];
+    nom.scene.getSystem().realize(nomWork_, SimTK::Stage::Acceleration);
+    const PointJacobians J = evalJacobians(nom.scene, nomWork_, colWork_, &nom.out, nom.stage, false, nom.zi);
+    evaluations_ += J.evaluations;
     const auto kkt = factorKkt(J);
     Point P;
     P.A = sensitivityMatrix(J, kkt);
@@ -335,161 +384,101 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
     P.y_b.resize(r);
     const int m = static_cast<int>(J.G.rows());
     for (int c = 0; c < r; ++c) {
-      SimTK::State& w = pwork[c];
+      SimTK::State& w = perturbed_.work[c];
+      const double delta = perturbed_.delta[c];
       w.setTime(t);
-      w.updQ() = nomWork.getQ();
-      w.updU() = nomWork.getU();
-      for (int j = 0; j < nw; ++j) w.updZ()[j] = nomWork.getZ()[zi[j]];
-      PointEvaluator ev(perturbed[c]->getScene(), w, &perturbed[c]->getScene().getOutput(cost.output), stage,
-                        ziPerturbed);
-      const Eval e = ev.eval(nomWork.getUDot(), nomWork.getMultipliers());
-      ++res.residual_evaluations;
+      w.updQ() = nomWork_.getQ();
+      w.updU() = nomWork_.getU();
+      for (int j = 0; j < nw; ++j) w.updZ()[j] = nomWork_.getZ()[nom.zi[j]];
+      const Scene& ps = perturbed_.models[c]->getScene();
+      PointEvaluator ev(ps, w, &ps.getOutput(output_), nom.stage, ziPerturbed_);
+      const Eval e = ev.eval(nomWork_.getUDot(), nomWork_.getMultipliers());
+      ++evaluations_;
       VectorXd rhs(nu + m);
-      rhs << -(e.R - J.nominal.R) / delta[c], -(e.a - J.nominal.a) / delta[c];  // R_b, a_b (4.44)
-      P.B.col(c) << (e.qdot - J.nominal.qdot) / delta[c], kkt.solve(rhs).head(nu), (e.zdot - J.nominal.zdot) / delta[c];
-      P.y_b[c] = (e.y - J.nominal.y) / delta[c];
+      rhs << -(e.R - J.nominal.R) / delta, -(e.a - J.nominal.a) / delta;  // R_b, a_b (4.44)
+      P.B.col(c) << (e.qdot - J.nominal.qdot) / delta, kkt.solve(rhs).head(nu), (e.zdot - J.nominal.zdot) / delta;
+      P.y_b[c] = (e.y - J.nominal.y) / delta;
     }
-    return points.emplace(k, std::move(P)).first->second;
-  };
-
-  // --- the linear sensitivity system on interpolated coefficients -----------
-  // The coefficients are sampled at nodes (indices on a finest grid of
-  // N0 2^max_levels intervals) and interpolated by piecewise cubic Lagrange
-  // polynomials through the four nearest nodes (error O(H^4) where the motion
-  // is smooth). The linear system is integrated by the trapezoidal rule with m
-  // substeps per node interval, and Richardson extrapolation from m/2 and m
-  // substeps (its estimate, a tenth of the tolerance, sets m). No realization
-  // happens between nodes, so the integration step costs only small dense
-  // linear algebra. The nodes adapt: each pass bisects the intervals whose
-  // interpolation indicator (left- against right-biased cubic at the
-  // midpoint, all coefficients normalized by their largest magnitude) is at
-  // least a tenth of the largest, so kinks of the motion (the tire's
-  // adhesion/sliding switches) get small intervals and smooth stretches long
-  // ones. The error estimate of d psi / d b is the change from the previous
-  // pass plus the integration estimate; passes continue until it is below the
-  // tolerance.
-  const MatrixXd I = MatrixXd::Identity(n, n);
-  struct Coeff {
-    MatrixXd A, B;
-    double y = 0;
-    RowVectorXd y_x, y_b;
-  };
-  std::vector<long> nodes;  // indices of nominal steps, first and last included
-  for (long j = 0; j <= N0; ++j) {
-    const double tj = t0 + T * j / N0;
-    long k = std::lower_bound(samples.begin(), samples.end(), tj, [](const Sample& a, double v) { return a.t < v; }) -
-             samples.begin();
-    k = std::min(k, finest);
-    if (nodes.empty() || k > nodes.back()) nodes.push_back(k);
+    return points_.emplace(k, std::move(P)).first->second;
   }
-  if (nodes.back() != finest) nodes.push_back(finest);
-  if (nodes.size() < 4)
-    throw Error("mixed: the nominal run took only " + std::to_string(finest) + " steps; at least 3 are needed");
-  auto timeOf = [&](long k) { return samples[k].t - t0; };
-  /// Cubic Lagrange weights of the 4 nodes from index i0 at tau.
-  auto weights = [&](long i0, double tau, double w[4]) {
-    double x[4];
-    for (int k = 0; k < 4; ++k) x[k] = timeOf(nodes[i0 + k]);
-    for (int k = 0; k < 4; ++k) {
-      w[k] = 1;
-      for (int l = 0; l < 4; ++l)
-        if (l != k) w[k] *= (tau - x[l]) / (x[k] - x[l]);
+  /// Steps whose coefficients were computed.
+  std::size_t size() const { return points_.size(); }
+  /// Residual evaluations (realizations) used so far.
+  int evaluations() const { return evaluations_; }
+
+ private:
+  const NominalRun& nom_;
+  PerturbedModels& perturbed_;
+  std::string output_;
+  std::vector<int> ziPerturbed_;
+  SimTK::State nomWork_, colWork_;
+  std::map<long, Point> points_;
+  int evaluations_ = 0;
+};
+
+/// The linear sensitivity system on interpolated coefficients. The nodes are
+/// indices of nominal steps (first and last included); the coefficients
+/// between them are piecewise cubic Lagrange polynomials through the four
+/// nearest nodes (error O(H^4) where the motion is smooth). On each node
+/// interval, m substeps of two-stage Radau IIA (order 3, L-stable: the stiff
+/// tire modes are damped at any step) integrate x_b' = A x_b + B from x_b(0),
+/// and the cost's derivative d psi / d b is accumulated on the same stages.
+/// No realization happens between nodes, so a substep costs only small dense
+/// linear algebra.
+class SensitivityIntegration {
+ public:
+  SensitivityIntegration(const NominalRun& nom, CoefficientNodes& points, const MatrixXd& X0, CostKind kind,
+                         double tolerance, int initialIntervals)
+      : nom_(nom), points_(points), X0_(X0), kind_(kind), tolerance_(tolerance) {
+    const long finest = nom.finest();
+    for (long j = 0; j <= initialIntervals; ++j) {
+      const double tj = nom.t0 + nom.T * j / initialIntervals;
+      long k = std::lower_bound(nom.samples.begin(), nom.samples.end(), tj,
+                                [](const Sample& a, double v) { return a.t < v; }) -
+               nom.samples.begin();
+      k = std::min(k, finest);
+      if (nodes_.empty() || k > nodes_.back()) nodes_.push_back(k);
     }
-  };
-  auto combine = [&](long i0, const double w[4], Coeff& c) {
-    const Point* P[4] = {&point(nodes[i0]), &point(nodes[i0 + 1]), &point(nodes[i0 + 2]), &point(nodes[i0 + 3])};
-    c.A = w[0] * P[0]->A + w[1] * P[1]->A + w[2] * P[2]->A + w[3] * P[3]->A;
-    c.B = w[0] * P[0]->B + w[1] * P[1]->B + w[2] * P[2]->B + w[3] * P[3]->B;
-    c.y = w[0] * P[0]->y + w[1] * P[1]->y + w[2] * P[2]->y + w[3] * P[3]->y;
-    c.y_x = w[0] * P[0]->y_x + w[1] * P[1]->y_x + w[2] * P[2]->y_x + w[3] * P[3]->y_x;
-    c.y_b = w[0] * P[0]->y_b + w[1] * P[1]->y_b + w[2] * P[2]->y_b + w[3] * P[3]->y_b;
-  };
-  /// Interpolated coefficients at tau in node interval i (centred stencil).
-  auto interp = [&](long i, double tau, Coeff& c) {
-    const long M = static_cast<long>(nodes.size());
-    const long i0 = std::max(0L, std::min(M - 4, i - 1));
-    double w[4];
-    weights(i0, tau, w);
-    combine(i0, w, c);
-  };
-  // Two-stage Radau IIA (order 3, L-stable: the stiff tire modes are damped
-  // at any step): c = (1/3, 1), a = [5/12 -1/12; 3/4 1/4], b = (3/4, 1/4).
-  // The cost integral uses the same stage values (Radau quadrature, order 3).
-  MatrixXd Kmat(2 * n, 2 * n), Krhs(2 * n, r);
-  auto radau = [&](int m) -> RowVectorXd {
-    MatrixXd X = X0;
-    RowVectorXd acc = RowVectorXd::Zero(r);
-    std::vector<double> ys;
-    std::vector<RowVectorXd> gs;  // y_b along the grid (maximum)
-    Coeff c0, c1, c2;
-    interp(0, 0.0, c0);
-    auto yb = [&](const Coeff& c, const MatrixXd& Xj) -> RowVectorXd { return c.y_x * Xj + c.y_b; };
-    if (cost.kind == CostKind::Maximum) {
-      ys.push_back(c0.y);
-      gs.push_back(yb(c0, X));
-    }
-    for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
-      const double ta = timeOf(nodes[i]), h = (timeOf(nodes[i + 1]) - ta) / m;
-      for (int j = 0; j < m; ++j) {
-        interp(static_cast<long>(i), ta + (j + 1.0 / 3.0) * h, c1);
-        interp(static_cast<long>(i), ta + (j + 1.0) * h, c2);
-        Kmat.topLeftCorner(n, n) = I - (5.0 / 12.0) * h * c1.A;
-        Kmat.topRightCorner(n, n) = (1.0 / 12.0) * h * c1.A;
-        Kmat.bottomLeftCorner(n, n) = -0.75 * h * c2.A;
-        Kmat.bottomRightCorner(n, n) = I - 0.25 * h * c2.A;
-        Krhs.topRows(n) = c1.A * X + c1.B;
-        Krhs.bottomRows(n) = c2.A * X + c2.B;
-        const MatrixXd K = Kmat.partialPivLu().solve(Krhs);
-        const MatrixXd X1 = X + h * ((5.0 / 12.0) * K.topRows(n) - (1.0 / 12.0) * K.bottomRows(n));
-        const MatrixXd X2 = X + h * (0.75 * K.topRows(n) + 0.25 * K.bottomRows(n));  // stiffly accurate
-        if (integral) acc += h * (0.75 * 2 * c1.y * yb(c1, X1) + 0.25 * 2 * c2.y * yb(c2, X2));  // (4.47)
-        X = X2;
-        if (cost.kind == CostKind::Maximum) {
-          ys.push_back(c2.y);
-          gs.push_back(yb(c2, X));
-        }
-        c0 = c2;
-      }
-    }
-    if (cost.kind == CostKind::FinalValue) return yb(c0, X);
-    if (integral) return acc;
-    // Maximum: d/db max_t y = y_b(t*) (t* interior); parabola through the grid maximum.
-    const std::size_t j = std::max_element(ys.begin(), ys.end()) - ys.begin();
-    if (j == 0 || j + 1 == ys.size()) return gs[j];
-    const double ym = ys[j - 1], y0 = ys[j], yp = ys[j + 1];
-    const double den = ym - 2 * y0 + yp;
-    const double th = den != 0 ? std::max(-1.0, std::min(1.0, 0.5 * (ym - yp) / den)) : 0.0;
-    return RowVectorXd(gs[j] + 0.5 * th * (gs[j + 1] - gs[j - 1]) +
-                       0.5 * th * th * (gs[j + 1] - 2 * gs[j] + gs[j - 1]));
-  };
-  int substeps = 2;
-  auto integrate = [&](RowVectorXd& err) -> RowVectorXd {
-    RowVectorXd Sh = radau(substeps / 2);
+    if (nodes_.back() != finest) nodes_.push_back(finest);
+    if (nodes_.size() < 4)
+      throw Error("mixed: the nominal run took only " + std::to_string(finest) + " steps; at least 3 are needed");
+  }
+
+  /// d psi / d b on the current nodes: Radau with `substeps` and half as many
+  /// per node interval; their difference / 7 (order 3) estimates the error
+  /// of the finer one (`err`). The substeps double (from 2, kept across
+  /// passes, at most 64) until that estimate is below a tenth of the
+  /// tolerance relative for every parameter.
+  RowVectorXd integrate(RowVectorXd& err) {
+    RowVectorXd Sh = radau(substeps_ / 2);
     for (;;) {
-      const RowVectorXd S = radau(substeps);
+      const RowVectorXd S = radau(substeps_);
       err = (S - Sh).cwiseAbs() / 7.0;  // order 3: estimate of the error of S
       bool ok = true;
       const double floor = 1e-14 * S.cwiseAbs().maxCoeff();
-      for (int c = 0; c < r; ++c) ok &= err[c] <= 0.1 * set.tolerance * std::abs(S[c]) + floor;
-      if (ok || substeps >= 64) return S;
+      for (int c = 0; c < S.size(); ++c) ok &= err[c] <= 0.1 * tolerance_ * std::abs(S[c]) + floor;
+      if (ok || substeps_ >= 64) return S;
       Sh = S;
-      substeps *= 2;
+      substeps_ *= 2;
     }
-  };
-  /// Interpolation indicator of each node interval.
-  auto indicators = [&]() {
-    const long M = static_cast<long>(nodes.size());
-    // Normalization: the largest magnitude of each coefficient over the nodes.
+  }
+
+  /// The interpolation indicator of each node interval: the left- against the
+  /// right-biased cubic at the interval's midpoint, every coefficient
+  /// normalized by its largest magnitude over the nodes (0 where the two
+  /// stencils coincide).
+  std::vector<double> indicators() {
+    const long M = static_cast<long>(nodes_.size());
     Coeff scale;
     {
-      const Point& P = point(nodes[0]);
+      const Point& P = points_.at(nodes_[0]);
       scale.A = P.A.cwiseAbs();
       scale.B = P.B.cwiseAbs();
       scale.y = std::abs(P.y);
       scale.y_x = P.y_x.cwiseAbs();
       scale.y_b = P.y_b.cwiseAbs();
       for (long i = 1; i < M; ++i) {
-        const Point& Q = point(nodes[i]);
+        const Point& Q = points_.at(nodes_[i]);
         scale.A = scale.A.cwiseMax(Q.A.cwiseAbs());
         scale.B = scale.B.cwiseMax(Q.B.cwiseAbs());
         scale.y = std::max(scale.y, std::abs(Q.y));
@@ -503,7 +492,7 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
     const double sy = inv(scale.y);
     std::vector<double> eta(M - 1, 0.0);
     for (long i = 0; i + 1 < M; ++i) {
-      const double tau = 0.5 * (timeOf(nodes[i]) + timeOf(nodes[i + 1]));
+      const double tau = 0.5 * (nom_.timeOf(nodes_[i]) + nom_.timeOf(nodes_[i + 1]));
       const long iL = std::max(0L, std::min(M - 4, i - 2)), iR = std::max(0L, std::min(M - 4, i - 1 + 1));
       if (iL == iR) continue;
       double w[4];
@@ -520,85 +509,230 @@ SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
       eta[i] = e;
     }
     return eta;
+  }
+
+  const std::vector<long>& getNodes() const { return nodes_; }
+  std::vector<long>& updNodes() { return nodes_; }
+  int getSubsteps() const { return substeps_; }
+
+ private:
+  /// Interpolated coefficients at one time.
+  struct Coeff {
+    MatrixXd A, B;
+    double y = 0;
+    RowVectorXd y_x, y_b;
   };
+
+  /// Cubic Lagrange weights of the 4 nodes from index i0 at tau.
+  void weights(long i0, double tau, double w[4]) const {
+    double x[4];
+    for (int k = 0; k < 4; ++k) x[k] = nom_.timeOf(nodes_[i0 + k]);
+    for (int k = 0; k < 4; ++k) {
+      w[k] = 1;
+      for (int l = 0; l < 4; ++l)
+        if (l != k) w[k] *= (tau - x[l]) / (x[k] - x[l]);
+    }
+  }
+  void combine(long i0, const double w[4], Coeff& c) {
+    const Point* P[4] = {&points_.at(nodes_[i0]), &points_.at(nodes_[i0 + 1]), &points_.at(nodes_[i0 + 2]),
+                         &points_.at(nodes_[i0 + 3])};
+    c.A = w[0] * P[0]->A + w[1] * P[1]->A + w[2] * P[2]->A + w[3] * P[3]->A;
+    c.B = w[0] * P[0]->B + w[1] * P[1]->B + w[2] * P[2]->B + w[3] * P[3]->B;
+    c.y = w[0] * P[0]->y + w[1] * P[1]->y + w[2] * P[2]->y + w[3] * P[3]->y;
+    c.y_x = w[0] * P[0]->y_x + w[1] * P[1]->y_x + w[2] * P[2]->y_x + w[3] * P[3]->y_x;
+    c.y_b = w[0] * P[0]->y_b + w[1] * P[1]->y_b + w[2] * P[2]->y_b + w[3] * P[3]->y_b;
+  }
+  /// Interpolated coefficients at tau in node interval i (centred stencil).
+  void interp(long i, double tau, Coeff& c) {
+    const long M = static_cast<long>(nodes_.size());
+    const long i0 = std::max(0L, std::min(M - 4, i - 1));
+    double w[4];
+    weights(i0, tau, w);
+    combine(i0, w, c);
+  }
+
+  /// d psi / d b with m Radau substeps per node interval. Two-stage Radau
+  /// IIA: c = (1/3, 1), a = [5/12 -1/12; 3/4 1/4], b = (3/4, 1/4). The cost
+  /// integral uses the same stage values (Radau quadrature, order 3) of
+  /// 2 y y_b (4.47); a final value is y_b at the end; a maximum is y_b at the
+  /// time of the grid maximum, refined by a parabola through it.
+  RowVectorXd radau(int m) {
+    const int n = nom_.n, r = static_cast<int>(X0_.cols());
+    const bool integral = kind_ == CostKind::IntegralOfSquare;
+    const MatrixXd I = MatrixXd::Identity(n, n);
+    MatrixXd Kmat(2 * n, 2 * n), Krhs(2 * n, r);
+    MatrixXd X = X0_;
+    RowVectorXd acc = RowVectorXd::Zero(r);
+    std::vector<double> ys;
+    std::vector<RowVectorXd> gs;  // y_b along the grid (maximum)
+    Coeff c0, c1, c2;
+    interp(0, 0.0, c0);
+    auto yb = [&](const Coeff& c, const MatrixXd& Xj) -> RowVectorXd { return c.y_x * Xj + c.y_b; };
+    if (kind_ == CostKind::Maximum) {
+      ys.push_back(c0.y);
+      gs.push_back(yb(c0, X));
+    }
+    for (std::size_t i = 0; i + 1 < nodes_.size(); ++i) {
+      const double ta = nom_.timeOf(nodes_[i]), h = (nom_.timeOf(nodes_[i + 1]) - ta) / m;
+      for (int j = 0; j < m; ++j) {
+        interp(static_cast<long>(i), ta + (j + 1.0 / 3.0) * h, c1);
+        interp(static_cast<long>(i), ta + (j + 1.0) * h, c2);
+        Kmat.topLeftCorner(n, n) = I - (5.0 / 12.0) * h * c1.A;
+        Kmat.topRightCorner(n, n) = (1.0 / 12.0) * h * c1.A;
+        Kmat.bottomLeftCorner(n, n) = -0.75 * h * c2.A;
+        Kmat.bottomRightCorner(n, n) = I - 0.25 * h * c2.A;
+        Krhs.topRows(n) = c1.A * X + c1.B;
+        Krhs.bottomRows(n) = c2.A * X + c2.B;
+        const MatrixXd K = Kmat.partialPivLu().solve(Krhs);
+        const MatrixXd X1 = X + h * ((5.0 / 12.0) * K.topRows(n) - (1.0 / 12.0) * K.bottomRows(n));
+        const MatrixXd X2 = X + h * (0.75 * K.topRows(n) + 0.25 * K.bottomRows(n));  // stiffly accurate
+        if (integral) acc += h * (0.75 * 2 * c1.y * yb(c1, X1) + 0.25 * 2 * c2.y * yb(c2, X2));  // (4.47)
+        X = X2;
+        if (kind_ == CostKind::Maximum) {
+          ys.push_back(c2.y);
+          gs.push_back(yb(c2, X));
+        }
+        c0 = c2;
+      }
+    }
+    if (kind_ == CostKind::FinalValue) return yb(c0, X);
+    if (integral) return acc;
+    // Maximum: d/db max_t y = y_b(t*) (t* interior); parabola through the grid maximum.
+    const std::size_t j = std::max_element(ys.begin(), ys.end()) - ys.begin();
+    if (j == 0 || j + 1 == ys.size()) return gs[j];
+    const double ym = ys[j - 1], y0 = ys[j], yp = ys[j + 1];
+    const double den = ym - 2 * y0 + yp;
+    const double th = den != 0 ? std::max(-1.0, std::min(1.0, 0.5 * (ym - yp) / den)) : 0.0;
+    return RowVectorXd(gs[j] + 0.5 * th * (gs[j + 1] - gs[j - 1]) +
+                       0.5 * th * th * (gs[j + 1] - 2 * gs[j] + gs[j - 1]));
+  }
+
+  const NominalRun& nom_;
+  CoefficientNodes& points_;
+  const MatrixXd& X0_;
+  CostKind kind_;
+  double tolerance_;
+  std::vector<long> nodes_;  // indices of nominal steps, first and last included
+  int substeps_ = 2;
+};
+
+/// The next pass's nodes: every interval longer than one step is bisected
+/// (uniform), or only those whose indicator `eta` is at least a tenth of the
+/// largest (adaptive: kinks of the motion, the tire's adhesion/sliding
+/// switches, get small intervals and smooth stretches long ones). Then
+/// neighbouring intervals are kept within a factor 2 of each other, so every
+/// cubic stencil is nearly uniform (uneven stencils amplify noise). Returns
+/// false, leaving `nodes` alone, if no interval can be bisected (every one is
+/// a single step, or every indicator is 0).
+bool refineNodes(std::vector<long>& nodes, const std::vector<double>& eta, MixedRefinement refinement) {
+  double etaMax = 0;
+  for (std::size_t i = 0; i < eta.size(); ++i)
+    if (nodes[i + 1] - nodes[i] > 1) etaMax = std::max(etaMax, eta[i]);
+  if (!(etaMax > 0)) return false;
+  const bool uniform = refinement == MixedRefinement::Uniform;
+  std::vector<long> refined;
+  for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
+    refined.push_back(nodes[i]);
+    if (nodes[i + 1] - nodes[i] > 1 && (uniform || eta[i] >= 0.1 * etaMax))
+      refined.push_back((nodes[i] + nodes[i + 1]) / 2);
+  }
+  refined.push_back(nodes.back());
+  for (bool changed = true; changed;) {
+    changed = false;
+    std::vector<long> balanced{refined[0]};
+    for (std::size_t i = 0; i + 1 < refined.size(); ++i) {
+      const long len = refined[i + 1] - refined[i];
+      const long left = i > 0 ? refined[i] - refined[i - 1] : len;
+      const long right = i + 2 < refined.size() ? refined[i + 2] - refined[i + 1] : len;
+      if (len > 1 && (len > 2 * left || len > 2 * right)) {
+        balanced.push_back((refined[i] + refined[i + 1]) / 2);
+        changed = true;
+      }
+      balanced.push_back(refined[i + 1]);
+    }
+    refined.swap(balanced);
+  }
+  nodes.swap(refined);
+  return true;
+}
+
+/// True if every parameter's error estimate `est` is within the tolerance
+/// relative to |d psi / d b_i| (`R`). A parameter whose normalized
+/// sensitivity |d psi / d b_i| s_i (s_i = max(|b_i|, scale_i)) is below 1e-3
+/// of the largest is held to that floor instead of its own (near-zero)
+/// magnitude.
+bool withinTolerance(const RowVectorXd& R, const RowVectorXd& est, double tolerance, const std::vector<int>& idx,
+                     const std::vector<double>& b0, const std::vector<DesignParameter>& params) {
+  const int r = static_cast<int>(R.size());
+  bool converged = true;
+  double normMax = 0;
+  for (int c = 0; c < r; ++c)
+    normMax = std::max(normMax, std::abs(R[c]) * std::max(std::abs(b0[idx[c]]), params[idx[c]].scale));
+  for (int c = 0; c < r; ++c) {
+    const double si = std::max(std::abs(b0[idx[c]]), params[idx[c]].scale);
+    converged &= est[c] <= tolerance * std::max(std::abs(R[c]), 1e-3 * normMax / si);
+  }
+  return converged;
+}
+
+/// The nominal run, the perturbed models, then passes: integrate on the
+/// current nodes, estimate the error of d psi / d b as the change from the
+/// previous pass plus the integration's own estimate, and refine the nodes
+/// until the estimate is below the tolerance.
+SensitivityResult MixedMethod::DoCompute(const SensitivityProblem& p) const {
+  const SensitivitySettings& set = settings();
+  const auto idx = p.parameterIndices();
+  const int r = static_cast<int>(idx.size());
+  const auto& params = p.model->getParameters();
+  const std::vector<double> b0 = p.model->getNominalValues();
+
+  const NominalRun nom(p, b0);
+  SensitivityResult res;
+  res.nominal_wall_time_s = nom.wall_time_s;
+  res.simulations = 1;
+  res.psi = nom.psi;
+
+  PerturbedModels perturbed(p, idx, b0, nom);
+  CoefficientNodes points(nom, perturbed, p.cost.output);
+  SensitivityIntegration integration(nom, points, perturbed.X0, p.cost.kind, set.tolerance, set.initial_intervals);
 
   RowVectorXd R_prev, R_cur, errInt, est = RowVectorXd::Constant(r, SimTK::Infinity);
   bool converged = false;
-  int pass = 0;
-  const bool uniformRefinement = !std::getenv("VDYN_MIXED_ADAPTIVE");
-  for (;; ++pass) {
-    R_cur = integrate(errInt);
-    if (std::getenv("VDYN_DEBUG_MIXED")) {
-      std::fprintf(stderr, "mixed pass %d nodes %zu substeps %d:", pass, nodes.size(), substeps);
-      for (int c = 0; c < r; ++c) std::fprintf(stderr, " %.10g", R_cur[c]);
-      std::fprintf(stderr, "\n");
+  for (int pass = 0;; ++pass) {
+    R_cur = integration.integrate(errInt);
+    if (logEnabled(LogLevel::Debug)) {
+      std::string line = logFormat("mixed: pass %d nodes %zu substeps %d:", pass, integration.getNodes().size(),
+                                   integration.getSubsteps());
+      for (int c = 0; c < r; ++c) line += logFormat(" %.10g", R_cur[c]);
+      logMessage(LogLevel::Debug, line);
     }
     if (pass >= 1) {
       est = (R_cur - R_prev).cwiseAbs() + errInt;
-      converged = true;
-      // A parameter whose normalized sensitivity |d psi / d b_i| s_i (s_i =
-      // max(|b_i|, scale_i)) is below 1e-3 of the largest is held to that
-      // floor instead of its own (near-zero) magnitude.
-      double normMax = 0;
-      for (int c = 0; c < r; ++c)
-        normMax = std::max(normMax, std::abs(R_cur[c]) * std::max(std::abs(b0[idx[c]]), params[idx[c]].scale));
-      for (int c = 0; c < r; ++c) {
-        const double si = std::max(std::abs(b0[idx[c]]), params[idx[c]].scale);
-        converged &= est[c] <= set.tolerance * std::max(std::abs(R_cur[c]), 1e-3 * normMax / si);
-      }
+      converged = withinTolerance(R_cur, est, set.tolerance, idx, b0, params);
     }
     R_prev = R_cur;
     if (converged) break;
-    // Refine: bisect the intervals with the largest indicators.
-    const std::vector<double> eta = indicators();
-    double etaMax = 0;
-    for (std::size_t i = 0; i < eta.size(); ++i)
-      if (nodes[i + 1] - nodes[i] > 1) etaMax = std::max(etaMax, eta[i]);
-    if (!(etaMax > 0)) break;
-    std::vector<long> refined;
-    for (std::size_t i = 0; i + 1 < nodes.size(); ++i) {
-      refined.push_back(nodes[i]);
-      if (nodes[i + 1] - nodes[i] > 1 && (uniformRefinement || eta[i] >= 0.1 * etaMax)) refined.push_back((nodes[i] + nodes[i + 1]) / 2);
-    }
-    refined.push_back(nodes.back());
-    // Keep neighbouring intervals within a factor 2 of each other, so every
-    // cubic stencil is nearly uniform (uneven stencils amplify noise).
-    for (bool changed = true; changed;) {
-      changed = false;
-      std::vector<long> balanced{refined[0]};
-      for (std::size_t i = 0; i + 1 < refined.size(); ++i) {
-        const long len = refined[i + 1] - refined[i];
-        const long left = i > 0 ? refined[i] - refined[i - 1] : len;
-        const long right = i + 2 < refined.size() ? refined[i + 2] - refined[i + 1] : len;
-        if (len > 1 && (len > 2 * left || len > 2 * right)) {
-          balanced.push_back((refined[i] + refined[i + 1]) / 2);
-          changed = true;
-        }
-        balanced.push_back(refined[i + 1]);
-      }
-      refined.swap(balanced);
-    }
-    nodes.swap(refined);
+    if (!refineNodes(integration.updNodes(), integration.indicators(), set.refinement)) break;
   }
   if (!converged) {
     int worst = 0;
     for (int c = 1; c < r; ++c)
       if (est[c] / std::abs(R_cur[c]) > est[worst] / std::abs(R_cur[worst])) worst = c;
     throw Error("mixed: the sensitivity integration did not reach the tolerance " + formatValue(set.tolerance) +
-                " with every one of the " + std::to_string(finest) +
+                " with every one of the " + std::to_string(nom.finest()) +
                 " nominal steps as a coefficient node: estimated relative error " +
                 formatValue(est[worst] / std::abs(R_cur[worst])) + " for " + params[idx[worst]].name);
   }
-  res.integration_steps = static_cast<int>((nodes.size() - 1) * substeps);  // Radau steps
-  res.grid_intervals = static_cast<int>(nodes.size() - 1);
+  const std::size_t intervals = integration.getNodes().size() - 1;
+  res.integration_steps = static_cast<int>(intervals * integration.getSubsteps());  // Radau steps
+  res.grid_intervals = static_cast<int>(intervals);
   res.grid_points = static_cast<int>(points.size());
+  res.residual_evaluations = points.evaluations();
   for (int c = 0; c < r; ++c) {
     res.dpsi_db.push_back(R_cur[c]);
     res.error_estimate.push_back(est[c]);
-    res.perturbation.push_back(delta[c]);
+    res.perturbation.push_back(perturbed.delta[c]);
   }
-  (void)wall0;
-  (void)matter;
   return res;
 }
 

@@ -182,6 +182,12 @@ class ReferenceMethod : public SensitivityMethod {
 
 }  // namespace
 
+MixedRefinement mixedRefinementFromName(const std::string& name, const std::string& where) {
+  if (name == "uniform") return MixedRefinement::Uniform;
+  if (name == "adaptive") return MixedRefinement::Adaptive;
+  throw Error(where + ": expected uniform or adaptive, got '" + name + "'");
+}
+
 const std::vector<std::string>& sensitivityMethodNames() {
   static const std::vector<std::string> names = {"fd_forward", "fd_central", "mixed", "reference"};
   return names;
@@ -201,8 +207,14 @@ void registerSensitivityMethods(PluginRegistry& registry) {
        {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "mixed", [](const ParamReader&, const S& s) { return detail::makeMixedMethod(s); },
-      {"the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients, one simulation",
-       {{"tolerance", "", "1e-05", "relative tolerance on the Richardson estimate of each d psi / d b_i"}}});
+      {"the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients at steps of one "
+       "simulation, integrated by Radau IIA",
+       {{"tolerance", "", "1e-05",
+         "relative tolerance on the error estimate of each d psi / d b_i (change from the previous pass plus the "
+         "Radau step-doubling estimate)"},
+        {"refinement", "", "uniform",
+         "node intervals bisected each pass: uniform (all) | adaptive (those whose interpolation indicator is >= 0.1 "
+         "of the largest)"}}});
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "reference",
       [](const ParamReader&, const S& s) { return std::make_unique<ReferenceMethod>(s); },

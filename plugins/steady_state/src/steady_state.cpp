@@ -1,6 +1,7 @@
 #include "vdyn/steady_state/steady_state.h"
 
 #include "vdyn/core/euler_state.h"
+#include "vdyn/core/log.h"
 
 #include <algorithm>
 #include <chrono>
@@ -313,7 +314,6 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
     return f <= opt_.force_tolerance && p <= opt_.position_tolerance && v <= opt_.velocity_tolerance &&
            z <= opt_.rate_tolerance && conditionsMet(rr);
   };
-  const bool debug = std::getenv("VDYN_DEBUG_STEADY") != nullptr;
   bool fresh = false;  // J_ was computed at the current x
   // A start that already solves the equations needs no Jacobian.
   bool needJacobian = !haveJacobian_ || !opt_.broyden || opt_.fresh_jacobian_each_solve;
@@ -340,9 +340,9 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
       decreased = rn.allFinite() && merit(rn) < (1.0 - 1e-4 * alpha) * m0;
       if (!decreased) alpha *= 0.5;
     }
-    if (debug)
-      std::fprintf(stderr, "steady: it %d alpha %g merit %.3e -> %.3e%s\n", res.iterations, alpha, m0,
-                   decreased ? merit(rn) : m0, fresh ? " (fresh J)" : "");
+    if (logEnabled(LogLevel::Debug))
+      logMessage(LogLevel::Debug, logFormat("steady: it %d alpha %g merit %.3e -> %.3e%s", res.iterations, alpha, m0,
+                                            decreased ? merit(rn) : m0, fresh ? " (fresh J)" : ""));
     if (!decreased) {
       if (fresh) {
         stalled = true;

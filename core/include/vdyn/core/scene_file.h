@@ -62,10 +62,11 @@ struct BuiltScene {
   SimTK::State makeInitialState() const { return vehicle->makeInitialState(initial_speed_m_s); }
 };
 
-/// One `--set key.path=value` override: the key path splits at '.'; an array
-/// element is named by its index ("plugins.0") or, for arrays of objects, by
-/// its "name" ("plugins.front_steer.command.final_rad"). The value is JSON
-/// (number, true/false, [..], {..}, "..."), or else taken as a string.
+/// One `--set key.path=value` override: `key_path` is a KeyPath
+/// (vdyn/core/key_path.h): parts split at '.', an array element named by its
+/// index ("plugins.0", "steps[1]") or, for arrays of objects, by its "name"
+/// ("plugins.front_steer.command.final_rad"). The value is JSON (number,
+/// true/false, [..], {..}, "..."), or else taken as a string.
 struct Override {
   std::string key_path;
   Json value;
@@ -73,9 +74,9 @@ struct Override {
   static Override parse(const std::string& text, const std::string& option = "--set");
 };
 
-/// Sets `value` at `keyPath` in `scene` (creating missing object keys; the
-/// strict key check then rejects a misspelt one). Throws Error naming `where`
-/// and the path if a part of the path is not an object or array.
+/// Sets the override's value at its KeyPath in `scene` (KeyPath::set: missing
+/// object keys are created; the strict key check then rejects a misspelt one).
+/// Throws KeyPath's Error, naming `where`, the path and the part that failed.
 void applyOverride(Json& scene, const Override& o, const std::string& where);
 
 class SceneDescription {

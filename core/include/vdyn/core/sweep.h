@@ -33,7 +33,7 @@
 
 namespace vdyn {
 
-/// One changed setting: a dotted key path into the scene ("a.b[2].c") and its value.
+/// One changed setting: a KeyPath into the scene ("a.b[2].c", vdyn/core/key_path.h) and its value.
 struct SweepSetting {
   std::string key;
   Json value;
@@ -143,11 +143,6 @@ struct SweepDescription {
   /// MPI ranks check they read the same sweep.
   std::uint64_t fingerprint() const;
 };
-
-/// The value at a dotted path in `j`, or nullptr. Array elements by index
-/// ("runs[3].x" or "runs.3.x") or, in arrays of objects, by their "name"
-/// ("plugins.front_steer.x", as scene --set paths name them).
-const Json* findJsonPath(const Json& j, const std::string& path);
 
 /// The result of one variation.
 struct SweepRow {

@@ -22,17 +22,25 @@
 // variable's scale, so each coefficient carries a relative error of about
 // 1e-8 (differences taken at the exact nominal point, no integrator noise).
 //
-// Integration. The nominal run (Simbody, error-controlled, its steps stored
-// with q, u, q', u' for cubic Hermite interpolation) is separate from the
-// sensitivity integration: the linear system x_b' = A(t) x_b + B(t) is
-// integrated by the trapezoidal rule (A-stable, so the stiff tire modes do not
-// limit the step) on uniform grids of N0, 2 N0, 4 N0, ... intervals, sharing
-// every coefficient evaluation of the coarser grids. The rule's global error
-// has an h^2, h^4, ... expansion, so Richardson's R_k = S_k + (S_k - S_{k-1})/3
-// is fourth order and |R_k - R_{k-1}| estimates (and, in the asymptotic range,
-// bounds) the error of R_{k-1} and so of R_k; the grid is halved until this
-// estimate is below tolerance * |d psi / d b_i| for every parameter. The
-// reported estimate is that bound. Errors not covered by it: the nominal
+// Integration (mixed.cpp, in these parts). The nominal run (Simbody,
+// error-controlled) stores every step's (t, q, u, z); it is separate from the
+// sensitivity integration. Coefficient nodes are a subset of those steps (at
+// first the steps nearest N0 = initial_intervals uniform times): their
+// coefficients A, B, y, y_x, y_b are evaluated once and kept, and between
+// nodes they are piecewise cubic Lagrange polynomials through the four
+// nearest nodes. The linear system x_b' = A(t) x_b + B(t) is integrated by
+// two-stage Radau IIA (order 3, L-stable, so the stiff tire modes do not
+// limit the step) with m substeps per node interval, the cost's derivative
+// on the same stages; m doubles (from 2, at most 64) until |S_m - S_{m/2}| / 7
+// (step doubling, order 3) is below a tenth of the tolerance. Passes: after
+// each, the node intervals are bisected (refinement "uniform": all of them;
+// "adaptive": those whose interpolation indicator, the left- against the
+// right-biased cubic at the midpoint, is at least a tenth of the largest),
+// then balanced so that neighbours differ by at most a factor 2. The error
+// estimate of d psi / d b_i is the change from the previous pass plus the
+// step-doubling estimate; passes continue until it is below tolerance *
+// |d psi / d b_i| for every parameter (an error naming the parameter once
+// every nominal step is a node). Errors not covered by it: the nominal
 // trajectory's own error (of the order of the integrator accuracy, relative)
 // and the finite-difference coefficient error (about 1e-8, relative).
 // The initial sensitivity x_b(0) is a central difference of the model's
@@ -68,9 +76,6 @@ struct ResidualJacobians {
 /// and udot_x is filled (the cross-check of the tests).
 ResidualJacobians calcResidualJacobians(const Scene& scene, const SimTK::State& state, SimTK::State& work,
                                         bool withForwardDynamics = false);
-
-/// A state of `scene` with Euler angles in place of quaternions, copying t, q, u, z of `state`.
-
 
 /// The coefficient matrix A = [(N u)_(q,u); U'] of x_b' = A x_b + B, where
 /// U' = -[I 0] [M G^T; G 0]^-1 [R_x; a_x]. Exposed for tests.

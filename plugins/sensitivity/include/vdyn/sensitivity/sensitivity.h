@@ -6,8 +6,10 @@
 //   mixed       the mixed method (4.23)-(4.44): direct-differentiation
 //               sensitivity equations whose coefficient matrices are finite
 //               differences of the equations-of-motion residual (Simbody
-//               inverse dynamics), integrated apart from the nominal run with
-//               a Richardson-controlled trapezoidal scheme (see mixed.h)
+//               inverse dynamics), sampled at steps of the nominal run,
+//               interpolated by cubics and integrated apart from it by
+//               two-stage Radau IIA; nodes refined pass by pass until the
+//               change of d psi / d b is below the tolerance (see mixed.h)
 //   reference   central differences at a tight integrator tolerance with two
 //               perturbation sizes that must agree; used to measure the others
 //
@@ -45,16 +47,30 @@ struct SensitivityProblem {
   std::vector<int> parameterIndices() const;
 };
 
+/// How the mixed method adds coefficient nodes between passes.
+enum class MixedRefinement {
+  Uniform,   ///< every node interval longer than one nominal step is bisected
+  Adaptive,  ///< only intervals whose interpolation indicator is >= 0.1 of the largest
+};
+
+/// "uniform" or "adaptive"; throws Error "<where>: expected uniform or
+/// adaptive, got '<name>'".
+MixedRefinement mixedRefinementFromName(const std::string& name, const std::string& where);
+
 struct SensitivitySettings {
   /// Finite differences: relative perturbation delta_i / max(|b_i|, scale_i);
   /// 0 selects the rule above from the integrator accuracy.
   double perturbation = 0;
-  /// mixed: relative tolerance on the Richardson error estimate of each
-  /// d psi / d b_i (the sensitivity integration error).
+  /// mixed: relative tolerance on the error estimate of each d psi / d b_i
+  /// (its change from the previous pass plus the Radau step-doubling estimate).
   double tolerance = 1e-5;
+  /// mixed: which node intervals each pass bisects (the scene key
+  /// "refinement": "uniform" | "adaptive").
+  MixedRefinement refinement = MixedRefinement::Uniform;
   /// mixed: intervals of the coarsest coefficient grid over [0, T] (>= 3).
   int initial_intervals = 32;
-  /// mixed: largest number of grid halvings.
+  /// mixed: checked to lie in [2, 16], otherwise unused: the passes refine
+  /// the nodes until the tolerance is met or every nominal step is a node.
   int max_levels = 9;
   /// reference: integrator accuracy and the larger relative perturbation (the
   /// second is half of it).
@@ -71,7 +87,8 @@ struct SensitivityResult {
   double psi = 0;                       ///< cost at the nominal design
   std::vector<double> dpsi_db;          ///< d psi / d b_i, in problem order
   /// The method's own error estimate of each d psi / d b_i (absolute): the
-  /// Richardson estimate (mixed), the disagreement of the two perturbation
+  /// change from the previous pass plus the Radau step-doubling estimate
+  /// (mixed), the disagreement of the two perturbation
   /// sizes (reference); empty for the plain finite differences.
   std::vector<double> error_estimate;
   std::vector<double> perturbation;     ///< delta_i used (finite differences), in the parameter's unit
@@ -79,8 +96,8 @@ struct SensitivityResult {
   int simulations = 0;                  ///< full time integrations
   // mixed only
   double nominal_wall_time_s = 0;       ///< the nominal integration within wall_time_s
-  int grid_intervals = 0;               ///< coefficient intervals of the finest level used
-  int integration_steps = 0;            ///< trapezoidal steps of the linear sensitivity system
+  int grid_intervals = 0;               ///< coefficient node intervals of the last pass
+  int integration_steps = 0;            ///< Radau IIA steps of the linear sensitivity system (last pass)
   int grid_points = 0;                  ///< points where the coefficient matrices were evaluated
   int residual_evaluations = 0;         ///< realizations for r_theta, r_theta', r_b
 };
