@@ -192,21 +192,25 @@ void registerSensitivityMethods(PluginRegistry& registry) {
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "fd_forward",
       [](const ParamReader&, const S& s) { return std::make_unique<FiniteDifferenceMethod>(false, s); },
-      {"forward differences (4.21): r + 1 simulations, step sqrt(eps) max(|b|, scale)",
-       {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
+      typeInfo("forward differences (4.21): r + 1 simulations, step sqrt(eps) max(|b|, scale); no keys of its own "
+               "(the sensitivity analysis's perturbation)",
+               noFields()));
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "fd_central",
       [](const ParamReader&, const S& s) { return std::make_unique<FiniteDifferenceMethod>(true, s); },
-      {"central differences (4.22): 2 r + 1 simulations, step cbrt(eps) max(|b|, scale)",
-       {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
+      typeInfo("central differences (4.22): 2 r + 1 simulations, step cbrt(eps) max(|b|, scale); no keys of its own "
+               "(the sensitivity analysis's perturbation)",
+               noFields()));
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "mixed", [](const ParamReader&, const S& s) { return detail::makeMixedMethod(s); },
-      {"the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients, one simulation",
-       {{"tolerance", "", "1e-05", "relative tolerance on the Richardson estimate of each d psi / d b_i"}}});
+      typeInfo("the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients, one "
+               "simulation; no keys of its own (the sensitivity analysis's tolerance)",
+               noFields()));
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "reference",
       [](const ParamReader&, const S& s) { return std::make_unique<ReferenceMethod>(s); },
-      {"central differences at a tight accuracy with two perturbation sizes that must agree (Richardson)", {}});
+      typeInfo("central differences at a tight accuracy with two perturbation sizes that must agree (Richardson)",
+               noFields()));
 }
 
 namespace {

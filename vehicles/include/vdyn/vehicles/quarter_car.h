@@ -42,6 +42,8 @@ struct QuarterCarParams {
   void validate() const;
   /// Reads a quarter-car data file (it names the vehicle data file and corner).
   static QuarterCarParams fromFile(const std::string& path);
+  /// The data-file keys fromParams reads (`vdyn list vehicle`): the one key list.
+  static const FieldTable<QuarterCarParams>& fields();
   static QuarterCarParams fromParams(const ParamReader& r);
   /// A copy whose corner.spring_free_length_m puts the tabulated configuration in
   /// static equilibrium (the flag above is then cleared).
