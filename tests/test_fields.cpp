@@ -97,7 +97,8 @@ Listed listedKeys(const std::vector<FieldInfo>& fields, const std::string& what,
     }
     l.keys[parent].insert(path.back());
     if (!node->contains(path.back())) {
-      (*node)[path.back()] = sampleOf(f, what);
+      Json v = sampleOf(f, what);
+      if (!v.is_null()) (*node)[path.back()] = std::move(v);  // else reported; the key is left out
     } else if (f.type == "object" && !(*node)[path.back()].is_object()) {
       (*node)[path.back()] = Json::object();
     }

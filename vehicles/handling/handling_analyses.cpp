@@ -44,7 +44,9 @@ struct VehicleChoice {
 const std::vector<FieldInfo> kVehicleKeys = {
     {"rear_strategy", "-", "\"2ws\"", "4WS rear steer: 2ws, linear (Kr(U) of linear_bicycle), nonlinear (kr_table)"},
     {"kr_table", "-", "\"kr_table.json\"", "coefficient table of the nonlinear strategy"},
-    {"linear_bicycle", "-", "chapter 6 values", "linear bicycle of the linear strategy (mass_kg, ...)"},
+    {"linear_bicycle", "-", "chapter 6 values", "linear bicycle of the linear strategy (mass_kg, ...)", "custom",
+     R"({"mass_kg": 1024, "front_axle_to_com_m": 1.305, "rear_axle_to_com_m": 0.965,
+         "front_cornering_stiffness_N_per_rad": 1.4e5, "rear_cornering_stiffness_N_per_rad": 1.4e5})"},
     {"tire_width_m", "m", "0.195", "tire section width (vehicle width = track + this)"}};
 
 ParamReader vehicleData(const SceneDescription& d) {
@@ -434,7 +436,8 @@ void registerHandlingAnalyses(PluginRegistry& registry) {
         {"spin_limit_rad", "rad", "0.5", "|side slip| beyond this: spin-out, fails"},
         {"sample_s", "s", "0.005", "sampling of the motion (cone check)"},
         {"max_steps", "", "40000", "integrator steps a run may take (beyond: stopped, fails)"},
-        {"integrator", "-", "rk_merson 1e-6", "integrator settings"}}});
+        {"integrator", "-", "rk_merson 1e-6", "integrator settings", "custom",
+         R"({"method": "rk_merson", "accuracy": 1e-6})"}}});
   registry.addAnalysis(
       "vehicle_report", [](const ParamReader& r) { return std::make_unique<VehicleReportAnalysis>(r); },
       {"static corner/axle loads and heights (equilibrium solver) and suspension kinematics over wheel travel "

@@ -207,6 +207,7 @@ const FieldTable<RearSteerEntry>& rearSteerFields() {
           .object("linear_bicycle", &E::linear_bicycle, LinearBicycleParams::fields(),
                   "linear bicycle of the linear strategy (defaults: LinearBicycleParams)")
           .string("kr_table", &E::kr_table, "coefficient table file of the nonlinear strategy (kr_table.json)")
+          .sample("\"kr_table.json\"")
           .include(&E::tracking, trackingFields());
   return t;
 }

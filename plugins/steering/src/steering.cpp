@@ -479,6 +479,7 @@ const FieldTable<SteeringEntry>& steeringFields() {
           .string("chassis", &SteeringEntry::chassis, "chassis body (bindable)")
           .strings("knuckles", &SteeringEntry::knuckles,
                    "knuckle bodies steered together, e.g. [\"rf.knuckle\", \"lf.knuckle\"] (bindable: attach an axle)")
+          .sample("[\"rf.knuckle\"]")
           .vec3("spin_axis", &SteeringEntry::spin_axis, "-", "wheel spin axis in the knuckle frame (bindable)")
           .custom("command", "-", "required",
                   "{type: a steering_command (hold, smooth_step, steps, ...: `vdyn list steering_command`) with "
