@@ -237,6 +237,13 @@ void ParamReader::mark(const std::string& key) const {
   tracker_->queried[node_].insert(key);
 }
 
+std::vector<std::string> ParamReader::queriedKeys() const {
+  std::lock_guard<std::mutex> lock(tracker_->mutex);
+  const auto q = tracker_->queried.find(node_);
+  if (q == tracker_->queried.end()) return {};
+  return {q->second.begin(), q->second.end()};
+}
+
 namespace {
 std::string baseName(const std::string& path) { return path.substr(path.find_last_of('/') + 1); }
 

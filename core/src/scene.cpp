@@ -55,10 +55,6 @@ void PluginRegistry::requireNew(PluginKind kind, const std::string& type) const 
   if (has(kind, type)) throw Error(std::string(toString(kind)) + " plugin '" + type + "' is already registered");
 }
 
-void PluginRegistry::add(PluginKind kind, const std::string& type, Factory factory) {
-  add(kind, type, std::move(factory), TypeInfo{});
-}
-
 void PluginRegistry::add(PluginKind kind, const std::string& type, Factory factory, TypeInfo info) {
   if (!factory) throw Error("plugin factory for '" + type + "' is empty");
   if (kind == PluginKind::Vehicle || kind == PluginKind::Analysis)

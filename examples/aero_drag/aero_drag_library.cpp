@@ -17,6 +17,6 @@ VDYN_PLUGIN_EXPORT void vdyn_register_plugins(vdyn::PluginRegistry& registry) {
         if (spec.bindings.count("chassis")) p.body = spec.bindings.at("chassis");  // "attach": "chassis"
         return std::make_unique<vdyn_example::QuadraticDragPlugin>(spec.name, p);
       },
-      {"aerodynamic drag F = -rho Cd A |v - w| (v - w) / 2 on a body point (examples/aero_drag)",
-       vdyn_example::quadraticDragFields().describe()});
+      vdyn::typeInfo("aerodynamic drag F = -rho Cd A |v - w| (v - w) / 2 on a body point (examples/aero_drag)",
+                     vdyn_example::quadraticDragFields()));
 }

@@ -15,6 +15,6 @@ VDYN_PLUGIN_EXPORT void vdyn_register_plugins(vdyn::PluginRegistry& registry) {
         auto path = vdyn::makeReferencePath(spec.params.child("path"));
         return std::make_unique<vdyn_example::PurePursuitPlugin>(spec.name, p, std::move(path));
       },
-      {"pure pursuit path follower driving a state-driven steering (examples/pure_pursuit)",
-       vdyn_example::purePursuitFields().describe()});
+      vdyn::typeInfo("pure pursuit path follower driving a state-driven steering (examples/pure_pursuit)",
+                     vdyn_example::purePursuitFields()));
 }

@@ -1,7 +1,7 @@
 // vdyn: one program for scene files.
 //   vdyn run SCENE [--set key.path=value ...] [--out DIR] [--plugin PATH ...]
 //   vdyn check SCENE [--set ...] [--plugin PATH ...]
-//   vdyn list [KIND] [--plugin PATH ...]
+//   vdyn list [NAME] [--plugin PATH ...]   (NAME: a kind, a choice family or a type name)
 //   vdyn sweep SWEEP [--threads N] [--out DIR] ...; mpirun -n N vdyn sweep SWEEP --mpi
 // One source file per subcommand (run_command.cpp, check_command.cpp, list_command.cpp, sweep_command.cpp), listed in the
 // table below.
@@ -22,7 +22,7 @@ const std::vector<Command>& commands() {
        &runCommand},
       {"check", "check SCENE [--set key.path=value ...] [--plugin PATH ...]",
        "validate a scene file without running it; prints every error found", &checkCommand},
-      {"list", "list [KIND] [--plugin PATH ...]",
+      {"list", "list [NAME] [--plugin PATH ...]",
        "every registered vehicle, plugin and analysis with its keys, units, defaults and meaning", &listCommand},
       {"sweep", "sweep SWEEP [--threads N] [--out DIR] [--fresh] [--retry-failed] [--plugin PATH ...]; "
                 "mpirun -n N vdyn sweep SWEEP --mpi",

@@ -43,5 +43,5 @@ VDYN_PLUGIN_EXPORT void vdyn_register_plugins(vdyn::PluginRegistry& registry) {
         if (p.body.empty()) throw vdyn::Error(spec.params.at("body") + ": missing (give it or attach chassis)");
         return std::make_unique<Push>(spec.name, p);
       },
-      {"test fixture: constant force along ground x on a body", pushFields().describe()});
+      vdyn::typeInfo("test fixture: constant force along ground x on a body", pushFields()));
 }

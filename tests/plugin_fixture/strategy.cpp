@@ -28,5 +28,5 @@ VDYN_PLUGIN_EXPORT void vdyn_register_plugins(vdyn::PluginRegistry& registry) {
   registry.addChoice<vdyn::RearSteerStrategy, vdyn::RearSteerContext>(
       "rear_steer_strategy", "fixture_linear",
       [](const vdyn::ParamReader&, const vdyn::RearSteerContext& c) { return std::make_unique<FixtureLinear>(c.linear); },
-      {"test fixture: the linear law (6.9) from a plugin library", {}});
+      vdyn::typeInfo("test fixture: the linear law (6.9) from a plugin library; no keys of its own", vdyn::noFields()));
 }

@@ -39,32 +39,53 @@ RigidBodyParams lumpAxle(const DoubleWishboneParams& c, double track) {
 }
 }  // namespace
 
+const FieldTable<BicycleParams>& BicycleParams::fields() {
+  using P = BicycleParams;
+  static const auto t =
+      FieldTable<P>()
+          .custom("vehicle_data", "-", "required",
+                  "App. A vehicle data file the axles are lumped from (its chassis, front_right, rear_right, tire)",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader v = ParamReader::fromFile(r.string("vehicle_data"));
+                    p.chassis = RigidBodyParams::fromParams(v.child("chassis"));
+                    const DoubleWishboneParams front = DoubleWishboneParams::fromParams(v.child("front_right"));
+                    const DoubleWishboneParams rear = DoubleWishboneParams::fromParams(v.child("rear_right"));
+                    const Vec3 wf = wheelCentreInChassis(front), wr = wheelCentreInChassis(rear);
+                    p.front_axle_m = Vec3(wf[0], 0, wf[2]);
+                    p.rear_axle_m = Vec3(wr[0], 0, wr[2]);
+                    p.front_track_m = -2 * wf[1];
+                    p.rear_track_m = -2 * wr[1];
+                    p.front_axle = lumpAxle(front, p.front_track_m);
+                    p.rear_axle = lumpAxle(rear, p.rear_track_m);
+                    // The vehicle data's tire, with this file's "tire" merged over it.
+                    const ParamReader tire = v.child("tire");
+                    p.tire_plugin = tire.string("plugin");
+                    ParamReader tireParams = tire.child("params");
+                    if (r.has("tire")) {
+                      const ParamReader t = r.child("tire");
+                      p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
+                      if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
+                    }
+                    p.tire = TireParams::fromParams(tireParams);
+                    for (const char* k : {"chassis", "front_right", "rear_right", "tire"}) v.child(k).requireAllKeysRead();
+                  })
+          .sample("\"appendix_a.json\"")
+          .custom("fork", "-", "required", "rigid body of the steered fork",
+                  [](const ParamReader& r, P& p) { p.fork = RigidBodyParams::fromParams(r.child("fork")); })
+          .custom("tire", "-", "the vehicle's",
+                  "{\"plugin\", \"params\"} merged over the vehicle data's tire (read with vehicle_data)",
+                  [](const ParamReader& r, P&) { r.has("tire"); })
+          .sample("{}")
+          .custom("road", "-", "{\"type\": \"flat\"}", "road: {\"type\": flat|sine, ...}",
+                  [](const ParamReader& r, P& p) {
+                    if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
+                  })
+          .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z");
+  return t;
+}
+
 BicycleParams BicycleParams::fromParams(const ParamReader& r) {
-  BicycleParams p;
-  const ParamReader v = ParamReader::fromFile(r.string("vehicle_data"));
-  p.chassis = RigidBodyParams::fromParams(v.child("chassis"));
-  const DoubleWishboneParams front = DoubleWishboneParams::fromParams(v.child("front_right"));
-  const DoubleWishboneParams rear = DoubleWishboneParams::fromParams(v.child("rear_right"));
-  const Vec3 wf = wheelCentreInChassis(front), wr = wheelCentreInChassis(rear);
-  p.front_axle_m = Vec3(wf[0], 0, wf[2]);
-  p.rear_axle_m = Vec3(wr[0], 0, wr[2]);
-  p.front_track_m = -2 * wf[1];
-  p.rear_track_m = -2 * wr[1];
-  p.front_axle = lumpAxle(front, p.front_track_m);
-  p.rear_axle = lumpAxle(rear, p.rear_track_m);
-  p.fork = RigidBodyParams::fromParams(r.child("fork"));
-  const ParamReader tire = v.child("tire");
-  p.tire_plugin = tire.string("plugin");
-  ParamReader tireParams = tire.child("params");
-  if (r.has("tire")) {
-    const ParamReader t = r.child("tire");
-    p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
-    if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
-  }
-  p.tire = TireParams::fromParams(tireParams);
-  if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
-  p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
-  for (const char* k : {"chassis", "front_right", "rear_right", "tire"}) v.child(k).requireAllKeysRead();
+  BicycleParams p = fields().read(r);
   p.validate();
   return p;
 }

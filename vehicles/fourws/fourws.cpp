@@ -34,18 +34,42 @@ void FourWsParams::validate() const {
     throw Error("4ws forward_dynamics \"dense\" needs corner_model \"reduced\" (got \"" + corner_model + "\")");
 }
 
+const FieldTable<FourWsParams>& FourWsParams::fields() {
+  using P = FourWsParams;
+  static const auto t =
+      FieldTable<P>()
+          .custom("chassis", "-", "required", "rigid body: mass_kg, inertia_kg_m2, ... (appendix_a.json)",
+                  [](const ParamReader& r, P& p) { p.chassis = RigidBodyParams::fromParams(r.child("chassis")); })
+          .custom("front_right", "-", "required", "double-wishbone corner (LF mirrored from it)",
+                  [](const ParamReader& r, P& p) {
+                    p.front_right = DoubleWishboneParams::fromParams(r.child("front_right"));
+                  })
+          .custom("rear_right", "-", "required", "double-wishbone corner (LR mirrored from it)",
+                  [](const ParamReader& r, P& p) {
+                    p.rear_right = DoubleWishboneParams::fromParams(r.child("rear_right"));
+                  })
+          .custom("tire", "-", "required",
+                  "{\"plugin\": gim|fiala|linear|..., \"params\": {the tire's 'params: ...' keys (vdyn list gim)}}",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader tire = r.child("tire");
+                    p.tire_plugin = tire.string("plugin");
+                    p.tire = TireParams::fromParams(tire.child("params"));
+                  })
+          .custom("road", "-", "{\"type\": \"flat\"}", "road: {\"type\": flat|sine, ...}",
+                  [](const ParamReader& r, P& p) {
+                    if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
+                  })
+          .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
+          .string("corner_model", &P::corner_model,
+                  "constrained (each loop closed by a ball constraint) | reduced (loop solved in the knuckle's "
+                  "mobilizer)")
+          .string("forward_dynamics", &P::forward_dynamics,
+                  "simbody | dense (reduced corners only: the constraint rows solved as one dense system)");
+  return t;
+}
+
 FourWsParams FourWsParams::fromParams(const ParamReader& r) {
-  FourWsParams p;
-  p.chassis = RigidBodyParams::fromParams(r.child("chassis"));
-  p.front_right = DoubleWishboneParams::fromParams(r.child("front_right"));
-  p.rear_right = DoubleWishboneParams::fromParams(r.child("rear_right"));
-  const ParamReader tire = r.child("tire");
-  p.tire_plugin = tire.string("plugin");
-  p.tire = TireParams::fromParams(tire.child("params"));
-  if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
-  p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", p.gravity_m_per_s2);
-  p.corner_model = r.stringOr("corner_model", p.corner_model);
-  p.forward_dynamics = r.stringOr("forward_dynamics", p.forward_dynamics);
+  FourWsParams p = fields().read(r);
   if (p.corner_model != "constrained" && p.corner_model != "reduced")
     throw Error(r.where() + ": corner_model must be \"constrained\" or \"reduced\", got \"" + p.corner_model + "\"");
   r.requireAllKeysRead();

@@ -18,33 +18,57 @@ void QuarterCarParams::validate() const {
   if (tire_plugin.empty()) throw Error("quarter car tire plugin name is empty");
 }
 
+const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
+  using P = QuarterCarParams;
+  static const auto t =
+      FieldTable<P>()
+          .custom("vehicle_data", "-", "required",
+                  "App. A vehicle data file the corner and tire come from (with corner, corner_overrides, tire)",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader vehicle = ParamReader::fromFile(r.string("vehicle_data"));
+                    const std::string cornerName = r.stringOr("corner", "front_right");
+                    // The quarter car's own values are patched onto the vehicle data, so each
+                    // value lives in one data file: the corner and tire from App. A, the
+                    // chapter 4 values (m3, K, D, Cz, ...) in the quarter-car file.
+                    ParamReader corner = vehicle.child(cornerName);
+                    if (r.has("corner_overrides")) corner = corner.mergedWith(r.child("corner_overrides"));
+                    p.corner = DoubleWishboneParams::fromParams(corner);
+                    corner.requireAllKeysRead();
+                    const ParamReader tire = vehicle.child("tire");
+                    p.tire_plugin = tire.string("plugin");
+                    ParamReader tireParams = tire.child("params");
+                    if (r.has("tire")) {
+                      const ParamReader t = r.child("tire");
+                      p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
+                      if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
+                    }
+                    p.tire = TireParams::fromParams(tireParams);
+                    tire.requireAllKeysRead();
+                  })
+          .sample("\"appendix_a.json\"")
+          .custom("corner", "-", "\"front_right\"", "which corner of the vehicle data (read with vehicle_data)",
+                  [](const ParamReader& r, P&) { r.has("corner"); })
+          .custom("corner_overrides", "-", "{}", "keys merged over the corner (read with vehicle_data)",
+                  [](const ParamReader& r, P&) { r.has("corner_overrides"); })
+          .custom("tire", "-", "the vehicle's",
+                  "{\"plugin\", \"params\"} merged over the vehicle data's tire (read with vehicle_data)",
+                  [](const ParamReader& r, P&) { r.has("tire"); })
+          .sample("{}")
+          .number("chassis_mass_kg", &P::chassis_mass_kg, "kg", "quarter of the chassis mass (m1), > 0", true)
+          .custom("road", "-", "required", "road: {\"type\": flat|sine, ...}",
+                  [](const ParamReader& r, P& p) { p.road = RoadParams::fromParams(r.child("road")); })
+          .sample("{\"type\": \"flat\"}")
+          .number("upper_pivot_offset_m", &P::upper_pivot_offset_m, "m",
+                  "s', offset of the upper A-arm's inner pivot along zeta, + up")
+          .boolean("steer_lock", &P::steer_lock, "hold the steer angle at 90 deg (else the knuckle turns freely)")
+          .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
+          .boolean("spring_free_length_from_ride_height", &P::spring_free_length_from_ride_height,
+                   "replace the spring free length by the one that makes the tabulated configuration static");
+  return t;
+}
+
 QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r, const PluginRegistry* registry) {
-  QuarterCarParams p;
-  const ParamReader vehicle = ParamReader::fromFile(r.string("vehicle_data"));
-  const std::string cornerName = r.stringOr("corner", "front_right");
-  // The quarter car's own values are patched onto the vehicle data, so each
-  // value lives in one data file: the corner and tire from App. A, the
-  // chapter 4 values (m3, K, D, Cz, ...) in the quarter-car file.
-  ParamReader corner = vehicle.child(cornerName);
-  if (r.has("corner_overrides")) corner = corner.mergedWith(r.child("corner_overrides"));
-  p.corner = DoubleWishboneParams::fromParams(corner);
-  corner.requireAllKeysRead();
-  const ParamReader tire = vehicle.child("tire");
-  p.tire_plugin = tire.string("plugin");
-  ParamReader tireParams = tire.child("params");
-  if (r.has("tire")) {
-    const ParamReader t = r.child("tire");
-    p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
-    if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
-  }
-  p.tire = TireParams::fromParams(tireParams);
-  tire.requireAllKeysRead();
-  p.chassis_mass_kg = r.number("chassis_mass_kg");
-  p.road = RoadParams::fromParams(r.child("road"));
-  p.upper_pivot_offset_m = r.numberOr("upper_pivot_offset_m", 0.0);
-  p.steer_lock = r.booleanOr("steer_lock", true);
-  p.gravity_m_per_s2 = r.numberOr("gravity_m_per_s2", 9.81);
-  p.spring_free_length_from_ride_height = r.booleanOr("spring_free_length_from_ride_height", false);
+  QuarterCarParams p = fields().read(r);
   requirePositive(p.chassis_mass_kg, r.at("chassis_mass_kg"));
   p.validate();
   return p.spring_free_length_from_ride_height ? p.withRideHeightSpring(registry) : p;

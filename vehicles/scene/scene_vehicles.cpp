@@ -126,9 +126,12 @@ class QuarterCarSceneVehicle : public Vehicle {
   mutable AssemblyReport assembly_;
 };
 
-TypeInfo info(const std::string& summary, std::vector<FieldInfo> dataKeys) {
+/// The scene keys of a vehicle entry, then the vehicle data's keys (the table
+/// the builder reads the data with) as "data: <key>".
+template <class P>
+TypeInfo info(const std::string& summary, const FieldTable<P>& data) {
   TypeInfo t{summary, sceneVehicleKeys()};
-  for (auto& f : dataKeys) {
+  for (auto f : data.describe()) {
     f.key = "data: " + f.key;
     t.fields.push_back(std::move(f));
   }
@@ -142,27 +145,16 @@ void registerVehicles(PluginRegistry& registry) {
       "fourws", [](const VehicleSpec& s) { return std::make_unique<FourWsSceneVehicle>(s); },
       info("App. A 4WS vehicle: free chassis, four double-wishbone corners, four tires; attachments chassis, "
            "front_axle, rear_axle, rf, lf, rr, lr",
-           {{"chassis", "-", "required", "rigid body: mass_kg, inertia_kg_m2, ... (appendix_a.json)"},
-            {"front_right", "-", "required", "double-wishbone corner (LF mirrored from it)"},
-            {"rear_right", "-", "required", "double-wishbone corner (LR mirrored from it)"},
-            {"tire", "-", "required", "{\"plugin\": gim|fiala|linear|..., \"params\": {tire keys}}"},
-            {"road", "-", "flat", "road: {\"type\": flat|sine, ...}"},
-            {"gravity_m_per_s2", "m/s^2", "9.81", "gravity along -z"}}));
+           FourWsParams::fields()));
   registry.addVehicle(
       "bicycle", [](const VehicleSpec& s) { return std::make_unique<BicycleSceneVehicle>(s); },
       info("nonlinear bicycle (section 7.1): free chassis, steered fork, two axles of two tires; attachments "
            "chassis, front_axle, rear_axle",
-           {{"vehicle_data", "-", "required", "App. A vehicle data file the axles are lumped from"},
-            {"fork", "-", "required", "rigid body of the steered fork"},
-            {"tire", "-", "the vehicle's", "{\"plugin\", \"params\"} merged over the vehicle data's tire"}}));
+           BicycleParams::fields()));
   registry.addVehicle(
       "quarter_car", [](const VehicleSpec& s) { return std::make_unique<QuarterCarSceneVehicle>(s); },
       info("chapter 4 quarter car: App. A corner under a chassis on a vertical slider; attachments chassis, corner",
-           {{"vehicle_data", "-", "required", "App. A vehicle data file the corner and tire come from"},
-            {"corner", "-", "\"front_right\"", "which corner of the vehicle data"},
-            {"corner_overrides", "-", "{}", "keys merged over the corner"},
-            {"chassis_mass_kg", "kg", "required", "quarter of the chassis mass (m1)"},
-            {"road", "-", "required", "road: {\"type\": flat|sine, ...}"}}));
+           QuarterCarParams::fields()));
 }
 
 }  // namespace vdyn

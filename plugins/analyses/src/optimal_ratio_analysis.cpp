@@ -32,6 +32,8 @@ const FieldTable<RatioSettings>& ratioFields() {
                     e.linear = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
                     e.linear_start = true;
                   })
+          .sample("{\"mass_kg\": 1024, \"front_axle_to_com_m\": 1.305, \"rear_axle_to_com_m\": 0.965, "
+                  "\"front_cornering_stiffness_N_per_rad\": 1.4e5, \"rear_cornering_stiffness_N_per_rad\": 1.4e5}")
           .custom("side_slip_tolerance_rad", "rad", "1e-9", "|beta| of a zero-side-slip point",
                   [](const ParamReader& r, E& e) {
                     e.options.side_slip_tolerance_rad = r.numberOr("side_slip_tolerance_rad", 1e-9);

@@ -159,12 +159,14 @@ const FieldTable<SensitivityEntry>& sensitivityFields() {
                       e.parameters.push_back(p);
                     }
                   })
+          .sample("[\"vehicle.data.chassis.mass_kg\"]")
           .string("derived_data", &E::derived_data,
                   "nominal (values the vehicle derives from a rule, e.g. the quarter car's spring free length "
                   "from the ride height, are held at the nominal design's: a datum) | each_design (re-derived)")
           .numbers("scales", &E::scales, "(parameter's)",
                    "typical size of each parameter: perturbations scale with max(|b|, scale) (default |b|, or 1 if 0)")
           .string("cost", &E::cost, "integral_of_square|maximum|final_value:<output> (4.46)", true)
+          .sample("\"final_value:chassis.yaw_rate_rad_s\"")
           .strings("methods", &E::methods,
                    "sensitivity_method names (fd_forward | fd_central | mixed | reference | ...: `vdyn list "
                    "sensitivity_method`), each run in turn")

@@ -188,25 +188,43 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
                    }});
 }
 
+namespace {
+/// The keys of a "path_control" plugin entry (one table: read, documented by `vdyn list`).
+struct PathControlEntry {
+  std::string steering, chassis;
+  std::shared_ptr<const ReferencePath> path;
+  PathControlParams gains;
+};
+const FieldTable<PathControlEntry>& pathControlFields() {
+  using E = PathControlEntry;
+  static const auto t =
+      FieldTable<E>()
+          .custom("steering", "-", "required", "name of the state-driven steering plugin it drives (bindable)",
+                  [](const ParamReader& r, E& e) { if (r.has("steering")) e.steering = r.string("steering"); })
+          .sample("\"front_steer\"")
+          .custom("chassis", "-", "required", "chassis body (bindable: attach chassis)",
+                  [](const ParamReader& r, E& e) { if (r.has("chassis")) e.chassis = r.string("chassis"); })
+          .sample("\"chassis\"")
+          .custom("path", "-", "required",
+                  "reference path {type: lane_change (7.6)-(7.8) | j_turn (7.19)-(7.24) | double_lane_change, ...}",
+                  [](const ParamReader& r, E& e) { e.path = makeReferencePath(r.child("path")); })
+          .sample("{\"type\": \"lane_change\", \"length_m\": 30, \"shift_m\": 3}")
+          .object("gains", &E::gains, gainFields(), "gains and look-ahead", true);
+  return t;
+}
+}  // namespace
+
 void registerPathControlPlugins(PluginRegistry& registry) {
-  std::vector<FieldInfo> fields = {
-      {"steering", "-", "required", "name of the state-driven steering plugin it drives (bindable)"},
-      {"chassis", "-", "required", "chassis body (bindable: attach chassis)"},
-      {"path", "-", "required",
-       "reference path {type: lane_change (7.6)-(7.8) | j_turn (7.19)-(7.24), ...}"},
-      {"gains", "-", "required", "gains and look-ahead (the keys 'gains: ...' below)"}};
-  for (auto f : gainFields().describe()) {
-    f.key = "gains: " + f.key;
-    fields.push_back(std::move(f));
-  }
   registry.add(
       PluginKind::Controller, "path_control",
       [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-        return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"),
-                                                   makeReferencePath(spec.params.child("path")),
-                                                   PathControlParams::fromParams(spec.params.child("gains")));
+        PathControlEntry e = pathControlFields().read(spec.params);
+        e.gains.validate();
+        return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"), e.path,
+                                                   e.gains);
       },
-      {"path-following steering law (7.9)-(7.18) with look-ahead; outputs <name>.e1_m, ...", fields});
+      typeInfo("path-following steering law (7.9)-(7.18) with look-ahead; outputs <name>.e1_m, ...",
+               pathControlFields()));
 }
 
 }  // namespace vdyn

@@ -48,20 +48,22 @@ void registerRearSteerStrategies(PluginRegistry& registry) {
   using C = RearSteerContext;
   registry.addChoice<RearSteerStrategy, C>(
       "rear_steer_strategy", "2ws", [](const ParamReader&, const C&) { return std::make_unique<TwoWsStrategy>(); },
-      {"delta_r* = 0: conventional front steering", {}});
+      typeInfo("delta_r* = 0: conventional front steering", noFields()));
   registry.addChoice<RearSteerStrategy, C>(
       "rear_steer_strategy", "linear",
       [](const ParamReader&, const C& c) { return std::make_unique<LinearKrStrategy>(c.linear); },
-      {"delta_r* = Kr(U) delta_f, Kr of the linear bicycle at the current speed (6.1)-(6.9), (8.2)-(8.4)",
-       {{"linear_bicycle", "-", "defaults", "the rear_steer plugin's linear bicycle"}}});
+      typeInfo("delta_r* = Kr(U) delta_f, Kr of the linear bicycle at the current speed (6.1)-(6.9), (8.2)-(8.4); "
+               "no keys of its own: the rear_steer plugin's linear_bicycle",
+               noFields()));
   registry.addChoice<RearSteerStrategy, C>(
       "rear_steer_strategy", "nonlinear",
       [](const ParamReader&, const C& c) -> std::unique_ptr<RearSteerStrategy> {
         if (!c.table) throw Error("rear steer strategy 'nonlinear' needs a Kr coefficient table");
         return std::make_unique<NonlinearKrStrategy>(*c.table);
       },
-      {"Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1 and C2 interpolated in speed (Table 8.1)",
-       {{"kr_table", "-", "required", "the rear_steer plugin's coefficient table file (kr_table.json)"}}});
+      typeInfo("Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1 and C2 interpolated in speed (Table 8.1); no keys of "
+               "its own: the rear_steer plugin's kr_table (required)",
+               noFields()));
 }
 
 namespace {
@@ -174,34 +176,61 @@ void RearSteerPlugin::DoAddTo(Scene& scene) {
                    }});
 }
 
+namespace {
+/// The keys of a "rear_steer" plugin entry (one table: read, documented by `vdyn list`).
+struct RearSteerEntry {
+  std::string rear_steering, front_steering, chassis, strategy, kr_table;
+  LinearBicycleParams linear_bicycle;
+  RearSteerParams tracking;
+};
+const FieldTable<RearSteerEntry>& rearSteerFields() {
+  using E = RearSteerEntry;
+  // A bindable key: read here when given; the factory takes the binding first.
+  auto bindable = [](std::string E::*m, const char* key) {
+    return [m, key](const ParamReader& r, E& e) { if (r.has(key)) e.*m = r.string(key); };
+  };
+  static const auto t =
+      FieldTable<E>()
+          .custom("rear_steering", "-", "required", "state-driven rear steering plugin it drives (bindable)",
+                  bindable(&E::rear_steering, "rear_steering"))
+          .sample("\"rear_steer\"")
+          .custom("front_steering", "-", "required", "front steering plugin it follows (bindable)",
+                  bindable(&E::front_steering, "front_steering"))
+          .sample("\"front_steer\"")
+          .custom("chassis", "-", "required", "chassis body (bindable)", bindable(&E::chassis, "chassis"))
+          .sample("\"chassis\"")
+          .string("strategy", &E::strategy,
+                  "a rear_steer_strategy: 2ws | linear (Kr(U), 6.1-6.9) | nonlinear (Kr = C1 + C2 delta_f^2, 8.1) | "
+                  "... (`vdyn list rear_steer_strategy`)",
+                  true)
+          .sample("\"2ws\"")
+          .object("linear_bicycle", &E::linear_bicycle, LinearBicycleParams::fields(),
+                  "linear bicycle of the linear strategy (defaults: LinearBicycleParams)")
+          .string("kr_table", &E::kr_table, "coefficient table file of the nonlinear strategy (kr_table.json)")
+          .sample("\"kr_table.json\"")
+          .include(&E::tracking, trackingFields());
+  return t;
+}
+}  // namespace
+
 void registerRearSteerPlugins(PluginRegistry& registry) {
   registerRearSteerStrategies(registry);
-  std::vector<FieldInfo> fields = {
-      {"rear_steering", "-", "required", "state-driven rear steering plugin it drives (bindable)"},
-      {"front_steering", "-", "required", "front steering plugin it follows (bindable)"},
-      {"chassis", "-", "required", "chassis body (bindable)"},
-      {"strategy", "-", "required",
-       "a rear_steer_strategy: 2ws | linear (Kr(U), 6.1-6.9) | nonlinear (Kr = C1 + C2 delta_f^2, 8.1) | ... "
-       "(`vdyn list rear_steer_strategy`)"},
-      {"linear_bicycle", "-", "defaults", "linear bicycle {mass_kg, front/rear_axle_to_com_m, cornering stiffnesses}"},
-      {"kr_table", "-", "none", "coefficient table file of the nonlinear strategy (kr_table.json)"}};
-  for (auto f : trackingFields().describe()) fields.push_back(std::move(f));
   registry.add(
       PluginKind::Controller, "rear_steer",
       [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
         const ParamReader& r = spec.params;
-        const LinearBicycleParams linear =
-            r.has("linear_bicycle") ? LinearBicycleParams::fromParams(r.child("linear_bicycle")) : LinearBicycleParams{};
+        RearSteerEntry e = rearSteerFields().read(r);
+        if (r.has("linear_bicycle")) e.linear_bicycle = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
         std::unique_ptr<KrTable> table;
-        if (r.has("kr_table"))
-          table = std::make_unique<KrTable>(KrTable::fromFile(resolveDataPath(r.string("kr_table"))));
+        if (r.has("kr_table")) table = std::make_unique<KrTable>(KrTable::fromFile(resolveDataPath(e.kr_table)));
+        e.tracking.validate();
         return std::make_unique<RearSteerPlugin>(spec.name, spec.bound("rear_steering"), spec.bound("front_steering"),
                                                  spec.bound("chassis"),
-                                                 makeRearSteerStrategy(r.string("strategy"), linear, table.get(),
+                                                 makeRearSteerStrategy(e.strategy, e.linear_bicycle, table.get(),
                                                                        spec.registry, &r),
-                                                 RearSteerParams::fromParams(r));
+                                                 e.tracking);
       },
-      {"rear-wheel steering law tracking a target delta_r* (8.1)-(8.8)", fields});
+      typeInfo("rear-wheel steering law tracking a target delta_r* (8.1)-(8.8)", rearSteerFields()));
 }
 
 }  // namespace vdyn

@@ -198,27 +198,26 @@ void registerSensitivityMethods(PluginRegistry& registry) {
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "fd_forward",
       [](const ParamReader&, const S& s) { return std::make_unique<FiniteDifferenceMethod>(false, s); },
-      {"forward differences (4.21): r + 1 simulations, step sqrt(eps) max(|b|, scale)",
-       {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
+      typeInfo("forward differences (4.21): r + 1 simulations, step sqrt(eps) max(|b|, scale); no keys of its own "
+               "(the sensitivity analysis's perturbation)",
+               noFields()));
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "fd_central",
       [](const ParamReader&, const S& s) { return std::make_unique<FiniteDifferenceMethod>(true, s); },
-      {"central differences (4.22): 2 r + 1 simulations, step cbrt(eps) max(|b|, scale)",
-       {{"perturbation", "", "0", "relative step (0 = from the integrator accuracy)"}}});
+      typeInfo("central differences (4.22): 2 r + 1 simulations, step cbrt(eps) max(|b|, scale); no keys of its own "
+               "(the sensitivity analysis's perturbation)",
+               noFields()));
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "mixed", [](const ParamReader&, const S& s) { return detail::makeMixedMethod(s); },
-      {"the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients at steps of one "
-       "simulation, integrated by Radau IIA",
-       {{"tolerance", "", "1e-05",
-         "relative tolerance on the error estimate of each d psi / d b_i (change from the previous pass plus the "
-         "Radau step-doubling estimate)"},
-        {"refinement", "", "uniform",
-         "node intervals bisected each pass: uniform (all) | adaptive (those whose interpolation indicator is >= 0.1 "
-         "of the largest)"}}});
+      typeInfo("the mixed method (4.23)-(4.44): sensitivity equations with finite-difference coefficients at steps of "
+               "one simulation, integrated by Radau IIA; no keys of its own (the sensitivity analysis's tolerance and "
+               "refinement)",
+               noFields()));
   registry.addChoice<SensitivityMethod, S>(
       "sensitivity_method", "reference",
       [](const ParamReader&, const S& s) { return std::make_unique<ReferenceMethod>(s); },
-      {"central differences at a tight accuracy with two perturbation sizes that must agree (Richardson)", {}});
+      typeInfo("central differences at a tight accuracy with two perturbation sizes that must agree (Richardson)",
+               noFields()));
 }
 
 namespace {

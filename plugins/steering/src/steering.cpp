@@ -61,34 +61,79 @@ SteerCommandValue StepSequenceCommand::DoCalc(double t) const {
   return v;
 }
 
+namespace {
+// The keys of each built-in steering command (read by its factory, listed by `vdyn list`).
+struct HoldKeys {
+  double angle_rad = 0;
+};
+const FieldTable<HoldKeys>& holdFields() {
+  static const auto t = FieldTable<HoldKeys>().number("angle_rad", &HoldKeys::angle_rad, "rad", "held angle, + left");
+  return t;
+}
+struct SmoothStepKeys {
+  double initial_rad = 0, final_rad = 0, start_time_s = 0, duration_s = 0;
+};
+const FieldTable<SmoothStepKeys>& smoothStepFields() {
+  using K = SmoothStepKeys;
+  static const auto t = FieldTable<K>()
+                            .number("initial_rad", &K::initial_rad, "rad", "angle before the step, + left")
+                            .number("final_rad", &K::final_rad, "rad", "angle after the step, + left", true)
+                            .number("start_time_s", &K::start_time_s, "s", "t_i, start of the step", true)
+                            .number("duration_s", &K::duration_s, "s", "T, duration of the step", true);
+  return t;
+}
+struct StepKeys {
+  double start_time_s = 0, duration_s = 0, change_rad = 0;
+};
+const FieldTable<StepKeys>& stepFields() {
+  static const auto t = FieldTable<StepKeys>()
+                            .number("start_time_s", &StepKeys::start_time_s, "s", "start of the step", true)
+                            .number("duration_s", &StepKeys::duration_s, "s", "duration of the step", true)
+                            .number("change_rad", &StepKeys::change_rad, "rad", "change of angle, + left", true);
+  return t;
+}
+struct StepsKeys {
+  double initial_rad = 0;
+  std::vector<StepSequenceCommand::Step> steps;
+};
+const FieldTable<StepsKeys>& stepsFields() {
+  static const auto t =
+      FieldTable<StepsKeys>()
+          .number("initial_rad", &StepsKeys::initial_rad, "rad", "angle before the first step, + left")
+          .custom("steps", "-", "required", "[{start_time_s (s), duration_s (s), change_rad (rad)}, ...], each required",
+                  [](const ParamReader& r, StepsKeys& k) {
+                    for (const auto& e : r.array("steps")) {
+                      const StepKeys s = stepFields().read(e);
+                      k.steps.push_back({s.start_time_s, s.duration_s, s.change_rad});
+                    }
+                  })
+          .sample("[{\"start_time_s\": 0, \"duration_s\": 1, \"change_rad\": 0.01}]");
+  return t;
+}
+}  // namespace
+
 void registerSteeringCommands(PluginRegistry& registry) {
   registry.addChoice<SteeringCommand>(
       "steering_command", "hold",
-      [](const ParamReader& r, const NoContext&) { return std::make_unique<HoldCommand>(r.numberOr("angle_rad", 0.0)); },
-      {"a constant angle (HoldCommand; adjustable angle_rad)", {{"angle_rad", "rad", "0", "held angle, + left"}}});
+      [](const ParamReader& r, const NoContext&) {
+        return std::make_unique<HoldCommand>(holdFields().read(r).angle_rad);
+      },
+      typeInfo("a constant angle (HoldCommand; adjustable angle_rad)", holdFields()));
   registry.addChoice<SteeringCommand>(
       "steering_command", "smooth_step",
       [](const ParamReader& r, const NoContext&) {
-        const double d0 = r.numberOr("initial_rad", 0.0);
-        return std::make_unique<SmoothStepCommand>(d0, r.number("final_rad") - d0, r.number("start_time_s"),
-                                                   r.number("duration_s"));
+        const SmoothStepKeys k = smoothStepFields().read(r);
+        return std::make_unique<SmoothStepCommand>(k.initial_rad, k.final_rad - k.initial_rad, k.start_time_s,
+                                                   k.duration_s);
       },
-      {"the seed's smooth step (7.4)-(7.5) from initial_rad to final_rad",
-       {{"initial_rad", "rad", "0", "angle before the step, + left"},
-        {"final_rad", "rad", "required", "angle after the step, + left"},
-        {"start_time_s", "s", "required", "t_i, start of the step"},
-        {"duration_s", "s", "required", "T, duration of the step"}}});
+      typeInfo("the seed's smooth step (7.4)-(7.5) from initial_rad to final_rad", smoothStepFields()));
   registry.addChoice<SteeringCommand>(
       "steering_command", "steps",
       [](const ParamReader& r, const NoContext&) {
-        std::vector<StepSequenceCommand::Step> steps;
-        for (const auto& k : r.array("steps"))
-          steps.push_back({k.number("start_time_s"), k.number("duration_s"), k.number("change_rad")});
-        return std::make_unique<StepSequenceCommand>(r.numberOr("initial_rad", 0.0), std::move(steps));
+        StepsKeys k = stepsFields().read(r);
+        return std::make_unique<StepSequenceCommand>(k.initial_rad, std::move(k.steps));
       },
-      {"smooth steps (7.4) added together (Figure 7.2's open-loop inputs)",
-       {{"initial_rad", "rad", "0", "angle before the first step, + left"},
-        {"steps", "-", "required", "[{start_time_s (s), duration_s (s), change_rad (rad)}, ...]"}}});
+      typeInfo("smooth steps (7.4) added together (Figure 7.2's open-loop inputs)", stepsFields()));
 }
 
 namespace {
@@ -434,6 +479,7 @@ const FieldTable<SteeringEntry>& steeringFields() {
           .string("chassis", &SteeringEntry::chassis, "chassis body (bindable)")
           .strings("knuckles", &SteeringEntry::knuckles,
                    "knuckle bodies steered together, e.g. [\"rf.knuckle\", \"lf.knuckle\"] (bindable: attach an axle)")
+          .sample("[\"rf.knuckle\"]")
           .vec3("spin_axis", &SteeringEntry::spin_axis, "-", "wheel spin axis in the knuckle frame (bindable)")
           .custom("command", "-", "required",
                   "{type: a steering_command (hold, smooth_step, steps, ...: `vdyn list steering_command`) with "
@@ -446,7 +492,8 @@ const FieldTable<SteeringEntry>& steeringFields() {
                     } else {
                       e.command = makeSteeringCommand(c, e.registry);
                     }
-                  });
+                  })
+          .sample("{\"type\": \"hold\"}");
   return t;
 }
 
@@ -479,9 +526,9 @@ void registerSteeringPlugins(PluginRegistry& registry) {
         }
         return std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, e.command, spin);
       },
-      {"steering angle of knuckles (A.1)-(A.4) held on a time command (holonomic constraint) or state-driven "
-       "by a controller; outputs <name>.angle_rad, <name>.command_rad",
-       steeringFields().describe()});
+      typeInfo("steering angle of knuckles (A.1)-(A.4) held on a time command (holonomic constraint) or "
+               "state-driven by a controller; outputs <name>.angle_rad, <name>.command_rad",
+               steeringFields()));
 }
 
 }  // namespace vdyn

@@ -24,13 +24,21 @@ void LinearBicycleParams::validate() const {
   requirePositive(rear_cornering_stiffness_N_per_rad, "linear bicycle rear_cornering_stiffness_N_per_rad");
 }
 
+const FieldTable<LinearBicycleParams>& LinearBicycleParams::fields() {
+  using P = LinearBicycleParams;
+  static const auto t = FieldTable<P>()
+                            .number("mass_kg", &P::mass_kg, "kg", "M, total mass", true)
+                            .number("front_axle_to_com_m", &P::front_axle_to_com_m, "m", "a, c.m. to front axle", true)
+                            .number("rear_axle_to_com_m", &P::rear_axle_to_com_m, "m", "b, c.m. to rear axle", true)
+                            .number("front_cornering_stiffness_N_per_rad", &P::front_cornering_stiffness_N_per_rad,
+                                    "N/rad", "C_af, whole front axle", true)
+                            .number("rear_cornering_stiffness_N_per_rad", &P::rear_cornering_stiffness_N_per_rad,
+                                    "N/rad", "C_ar, whole rear axle", true);
+  return t;
+}
+
 LinearBicycleParams LinearBicycleParams::fromParams(const ParamReader& r) {
-  LinearBicycleParams p;
-  p.mass_kg = r.number("mass_kg");
-  p.front_axle_to_com_m = r.number("front_axle_to_com_m");
-  p.rear_axle_to_com_m = r.number("rear_axle_to_com_m");
-  p.front_cornering_stiffness_N_per_rad = r.number("front_cornering_stiffness_N_per_rad");
-  p.rear_cornering_stiffness_N_per_rad = r.number("rear_cornering_stiffness_N_per_rad");
+  LinearBicycleParams p = fields().read(r);
   r.requireAllKeysRead();
   try {
     p.validate();

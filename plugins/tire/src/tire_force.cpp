@@ -205,37 +205,58 @@ void TirePlugin::DoAddTo(Scene& scene) {
   add("slip_angle_rad", "rad", [](const TireContact& c) { return c.forces.slip_angle_rad; });
 }
 
+namespace {
+/// The keys of a tire plugin entry (every tire kind).
+struct TireSpec {
+  std::string wheel;
+  SimTK::Vec3 spin_axis{0, 1, 0};
+  SimTK::Vec3 centre_m{0, 0, 0};
+  bool has_slip_centre = false;
+  SimTK::Vec3 slip_centre_m{0, 0, 0};
+  TireParams params;
+};
+const FieldTable<TireSpec>& tireSpecFields() {
+  static const auto t =
+      FieldTable<TireSpec>()
+          .custom("wheel", "-", "required", "wheel body (bindable: attach a corner)",
+                  [](const ParamReader& r, TireSpec& s) { if (r.has("wheel")) s.wheel = r.string("wheel"); })
+          .sample("\"wheel\"")
+          .vec3("spin_axis", &TireSpec::spin_axis, "-", "spin axis in the wheel frame")
+          .vec3("centre_m", &TireSpec::centre_m, "m", "tire centre on the wheel's spin axis, wheel frame")
+          .custom("slip_centre_m", "m", "centre_m", "where slip velocities are taken, wheel frame",
+                  [](const ParamReader& r, TireSpec& s) {
+                    s.has_slip_centre = r.has("slip_centre_m");
+                    if (s.has_slip_centre) s.slip_centre_m = r.vec3("slip_centre_m");
+                  })
+          .sample("[0, 0, 0]")
+          .object("params", &TireSpec::params, TireParams::fields(), "tire parameters (the keys 'params: ...')");
+  return t;
+}
+}  // namespace
+
 void registerTirePlugins(PluginRegistry& registry) {
   static const char* summaries[3][2] = {
       {"gim", "the seed's analytical comprehensive-slip tire (Gim and Nikravesh) on a wheel body"},
       {"fiala", "the Fiala tire as published, on a wheel body"},
       {"linear", "linear tire Fx = C_s kappa, Fy = -C_a alpha (no saturation), on a wheel body"}};
   for (const auto& [type, summary] : summaries) {
-    std::vector<FieldInfo> fields = {
-        {"wheel", "-", "required", "wheel body (bindable: attach a corner)"},
-        {"spin_axis", "-", "[0,1,0]", "spin axis in the wheel frame"},
-        {"centre_m", "m", "[0,0,0]", "tire centre on the wheel's spin axis, wheel frame"},
-        {"slip_centre_m", "m", "centre_m", "where slip velocities are taken, wheel frame"},
-        {"params", "-", "{}", "tire parameters (the keys 'params: ...' below)"}};
-    for (auto f : TireParams::describe()) {
-      f.key = "params: " + f.key;
-      fields.push_back(std::move(f));
-    }
     const std::string t = type;
     registry.add(
         PluginKind::ForceElement, t,
         [t](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-          const TireParams p = spec.params.has("params") ? TireParams::fromParams(spec.params.child("params"))
-                                                         : TireParams{};
-          SimTK::Vec3 axis = spec.params.vec3Or("spin_axis", SimTK::Vec3(0, 1, 0));
-          auto plugin = std::make_unique<TirePlugin>(t, spec.name, spec.bound("wheel"), makeTireModel(t, p),
-                                                     SimTK::UnitVec3(axis), "road",
-                                                     spec.params.vec3Or("centre_m", SimTK::Vec3(0)));
-          if (spec.params.has("slip_centre_m")) plugin->setSlipCentre(spec.params.vec3("slip_centre_m"));
+          const TireSpec s = tireSpecFields().read(spec.params);
+          if (spec.params.has("params")) {
+            const ParamReader p = spec.params.child("params");
+            p.requireAllKeysRead();  // an unknown tire key is an error, with the nearest key as a hint
+            s.params.validate(p.where());
+          }
+          auto plugin = std::make_unique<TirePlugin>(t, spec.name, spec.bound("wheel"), makeTireModel(t, s.params),
+                                                     SimTK::UnitVec3(s.spin_axis), "road", s.centre_m);
+          if (s.has_slip_centre) plugin->setSlipCentre(s.slip_centre_m);
           return plugin;
         },
-        TypeInfo{std::string(summary) + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad",
-                 fields});
+        typeInfo(std::string(summary) + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad",
+                 tireSpecFields()));
   }
 }
 

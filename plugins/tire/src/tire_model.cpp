@@ -39,50 +39,37 @@ void TireParams::validate(const std::string& w) const {
   requireNonNegative(relaxation_length_lateral_m, w + ".relaxation_length_lateral_m");
 }
 
-const std::vector<TireParams::Field>& TireParams::fields() {
-  static const std::vector<Field> f = {
-      {"unloaded_radius_m", &TireParams::unloaded_radius_m, "m", "R1, torus outer radius (Table A.4)"},
-      {"carcass_radius_m", &TireParams::carcass_radius_m, "m", "R2, torus tube radius (0 = thin disc)"},
-      {"radial_stiffness_N_per_m", &TireParams::radial_stiffness_N_per_m, "N/m", "Kz, radial stiffness (Table A.4)"},
-      {"radial_damping_N_s_per_m", &TireParams::radial_damping_N_s_per_m, "N s/m", "Cz, radial damping (not in the seed)"},
-      {"longitudinal_stiffness_N", &TireParams::longitudinal_stiffness_N, "N", "C_s, per unit slip ratio (Table A.4)"},
-      {"cornering_stiffness_N_per_rad", &TireParams::cornering_stiffness_N_per_rad, "N/rad", "C_a (Table A.4)"},
-      {"camber_stiffness_N_per_rad", &TireParams::camber_stiffness_N_per_rad, "N/rad", "C_g, camber thrust at small slip"},
-      {"mu_max", &TireParams::mu_max, "", "friction coefficient at zero comprehensive slip"},
-      {"mu_min", &TireParams::mu_min, "", "friction coefficient at full sliding"},
-      {"rolling_resistance_coefficient", &TireParams::rolling_resistance_coefficient, "",
-       "My = -c Fz Re against the spin"},
-      {"low_speed_threshold_m_s", &TireParams::low_speed_threshold_m_s, "m/s",
-       "slip denominators held at this speed near standstill"},
-      {"rolling_radius_deflection_factor", &TireParams::rolling_radius_deflection_factor, "",
-       "f in Re = R1 - f delta"},
-      {"relaxation_length_longitudinal_m", &TireParams::relaxation_length_longitudinal_m, "m",
-       "sigma_x (0 = steady slip, the seed's)"},
-      {"relaxation_length_lateral_m", &TireParams::relaxation_length_lateral_m, "m", "sigma_y (0 = steady slip)"},
-  };
-  return f;
-}
-
-std::vector<FieldInfo> TireParams::describe() {
-  const TireParams def;
-  std::vector<FieldInfo> out;
-  for (const auto& f : fields()) out.push_back({f.key, f.unit, Json(def.*f.member).dump(), f.meaning});
-  return out;
+const FieldTable<TireParams>& TireParams::fields() {
+  using P = TireParams;
+  static const auto t = FieldTable<P>()
+      .number("unloaded_radius_m", &P::unloaded_radius_m, "m", "R1, torus outer radius (Table A.4)")
+      .number("carcass_radius_m", &P::carcass_radius_m, "m", "R2, torus tube radius (0 = thin disc)")
+      .number("radial_stiffness_N_per_m", &P::radial_stiffness_N_per_m, "N/m", "Kz, radial stiffness (Table A.4)")
+      .number("radial_damping_N_s_per_m", &P::radial_damping_N_s_per_m, "N s/m", "Cz, radial damping (not in the seed)")
+      .number("longitudinal_stiffness_N", &P::longitudinal_stiffness_N, "N", "C_s, per unit slip ratio (Table A.4)")
+      .number("cornering_stiffness_N_per_rad", &P::cornering_stiffness_N_per_rad, "N/rad", "C_a (Table A.4)")
+      .number("camber_stiffness_N_per_rad", &P::camber_stiffness_N_per_rad, "N/rad", "C_g, camber thrust at small slip")
+      .number("mu_max", &P::mu_max, "", "friction coefficient at zero comprehensive slip")
+      .number("mu_min", &P::mu_min, "", "friction coefficient at full sliding")
+      .number("rolling_resistance_coefficient", &P::rolling_resistance_coefficient, "",
+              "My = -c Fz Re against the spin")
+      .number("low_speed_threshold_m_s", &P::low_speed_threshold_m_s, "m/s",
+              "slip denominators held at this speed near standstill")
+      .number("rolling_radius_deflection_factor", &P::rolling_radius_deflection_factor, "", "f in Re = R1 - f delta")
+      .number("relaxation_length_longitudinal_m", &P::relaxation_length_longitudinal_m, "m",
+              "sigma_x (0 = steady slip, the seed's)")
+      .number("relaxation_length_lateral_m", &P::relaxation_length_lateral_m, "m", "sigma_y (0 = steady slip)");
+  return t;
 }
 
 TireParams TireParams::fromParams(const ParamReader& r) {
-  TireParams p;
-  for (const auto& f : fields()) p.*f.member = r.numberOr(f.key, p.*f.member);
-  r.requireAllKeysRead();  // an unknown key is an error, with the nearest of fields() as a hint
+  TireParams p = fields().read(r);
+  r.requireAllKeysRead();  // an unknown key is an error, with the nearest key as a hint
   p.validate(r.where());
   return p;
 }
 
-Json TireParams::toJson() const {
-  Json j = Json::object();
-  for (const auto& f : fields()) j[f.key] = this->*f.member;
-  return j;
-}
+Json TireParams::toJson() const { return fields().write(*this); }
 
 TireModel::TireModel(const TireParams& p) : p_(p) { p_.validate(); }
 

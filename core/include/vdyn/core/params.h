@@ -88,6 +88,9 @@ class ParamReader {
   /// Marks every key under this node as read (a loader that gave up on a part
   /// after reporting its error, so the part's keys are not reported again).
   void markAllRead() const;
+  /// The keys any accessor asked this node for, present or not, sorted (the
+  /// keys a loader reads; tests compare them with the field table's keys).
+  std::vector<std::string> queriedKeys() const;
   /// This node with `patch` merged over it (RFC 7396 merge patch), as a new
   /// reader named like this one. Its requireAllKeysRead() checks the patch's
   /// keys first and names an unknown one by the patch's own key path (what the

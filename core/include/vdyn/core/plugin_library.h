@@ -4,7 +4,8 @@
 //
 //   extern "C" int vdyn_plugin_abi_version() { return VDYN_PLUGIN_ABI_VERSION; }
 //   extern "C" void vdyn_register_plugins(vdyn::PluginRegistry& registry) {
-//     registry.add(vdyn::PluginKind::ForceElement, "aero_drag", makeAeroDrag, aeroDragInfo());
+//     registry.add(vdyn::PluginKind::ForceElement, "aero_drag", makeAeroDrag,
+//                  vdyn::typeInfo("summary", aeroDragFields()));
 //   }
 //
 // (VDYN_PLUGIN_EXPORT below writes both declarations.) A scene names the
@@ -21,9 +22,10 @@
 /// Bumped whenever a class a plugin derives from or calls (Plugin and its kinds,
 /// PluginRegistry, PluginSpec, ParamReader, Scene, Vehicle, Analysis, TypeInfo)
 /// changes its layout or virtual functions. 2: PluginSpec::registry, choices
-/// in PluginRegistry, Vehicle::getConcrete/derivedData. A library must return the value it
+/// in PluginRegistry, Vehicle::getConcrete/derivedData. 3: FieldInfo::type; every
+/// registration takes its TypeInfo (typeInfo(summary, table)). A library must return the value it
 /// was compiled with from vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 2
+#define VDYN_PLUGIN_ABI_VERSION 3
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))

@@ -72,9 +72,12 @@ class PluginRegistry {
   using AnalysisFactory = std::function<std::unique_ptr<Analysis>(const ParamReader& settings)>;
 
 
+  // Every registration takes the type's TypeInfo, built with typeInfo(summary,
+  // table) from the FieldTable its factory reads with (fields.h), so the keys
+  // `vdyn list` prints are the keys the factory accepts.
+
   /// Registers a plugin factory (force element, constraint, controller); throws
   /// if (kind, type) is already registered.
-  void add(PluginKind kind, const std::string& type, Factory factory);
   void add(PluginKind kind, const std::string& type, Factory factory, TypeInfo info);
   /// Registers a vehicle builder (kind Vehicle).
   void addVehicle(const std::string& type, VehicleFactory factory, TypeInfo info);

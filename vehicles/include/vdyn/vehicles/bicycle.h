@@ -43,6 +43,8 @@ struct BicycleParams {
   /// axle masses are the sums of both corners, axle inertias add the corners'
   /// offsets (parallel axis), axle positions and tracks come from the joint
   /// points (wheelCentreInChassis). Keys "tire" and "fork" may override.
+  /// The data-file keys fromParams reads (`vdyn list vehicle`): the one key list.
+  static const FieldTable<BicycleParams>& fields();
   static BicycleParams fromParams(const ParamReader& r);
   static BicycleParams fromFile(const std::string& path);
 };

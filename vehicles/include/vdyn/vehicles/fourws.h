@@ -48,6 +48,8 @@ struct FourWsParams {
 
   void validate() const;
   /// Reads a vehicle data file in the layout of appendix_a.json.
+  /// The data-file keys fromParams reads (`vdyn list vehicle`): the one key list.
+  static const FieldTable<FourWsParams>& fields();
   static FourWsParams fromParams(const ParamReader& r);
   static FourWsParams fromFile(const std::string& path);
 };

@@ -42,6 +42,8 @@ struct QuarterCarParams {
   void validate() const;
   /// Reads a quarter-car data file (it names the vehicle data file and corner).
   static QuarterCarParams fromFile(const std::string& path);
+  /// The data-file keys fromParams reads (`vdyn list vehicle`): the one key list.
+  static const FieldTable<QuarterCarParams>& fields();
   /// `registry`: where the tire plugin is looked up for the ride-height rule
   /// (nullptr = the built-in plugins; a scene passes its own, so a tire from a
   /// plugin library works).

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "vdyn/core/error.h"
+#include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 
 namespace vdyn {
@@ -30,6 +31,8 @@ struct LinearBicycleParams {
   void validate() const;
   /// Reads { "mass_kg", "front_axle_to_com_m", "rear_axle_to_com_m",
   /// "front_cornering_stiffness_N_per_rad", "rear_cornering_stiffness_N_per_rad" }.
+  /// Its keys (all required): the one key list of fromParams and `vdyn list`.
+  static const FieldTable<LinearBicycleParams>& fields();
   static LinearBicycleParams fromParams(const ParamReader& r);
   static LinearBicycleParams fromFile(const std::string& path);
 };

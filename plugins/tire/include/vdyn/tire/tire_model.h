@@ -49,20 +49,13 @@ struct TireParams {
 
   /// Throws Error naming `where`.field and the value for a non-physical value.
   void validate(const std::string& where = "tire") const;
-  /// Keys are the field names above; missing keys keep the defaults.
+  /// Keys are the field names above; missing keys keep the defaults; unknown
+  /// keys are an error; validated.
   static TireParams fromParams(const ParamReader& r);
   /// The same keys, for data files and for plugin factories.
   Json toJson() const;
-  /// The one list of keys that fromParams, toJson and describe use.
-  struct Field {
-    const char* key;
-    double TireParams::*member;
-    const char* unit;     ///< SI unit ("" = dimensionless)
-    const char* meaning;  ///< one line
-  };
-  static const std::vector<Field>& fields();
-  /// The keys with units, defaults and meanings (`vdyn list`).
-  static std::vector<FieldInfo> describe();
+  /// The one list of keys that fromParams, toJson and `vdyn list` use.
+  static const FieldTable<TireParams>& fields();
 };
 
 /// Kinematics of the contact, computed by the force element (or given by a test).
