@@ -22,6 +22,8 @@ const FieldTable<HandlingSetup>& HandlingSetup::fields() {
                   [](const ParamReader& r, S& s) {
                     if (r.has("linear_bicycle")) s.linear = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
                   })
+          .sample(R"({"mass_kg": 1024, "front_axle_to_com_m": 1.305, "rear_axle_to_com_m": 0.965,
+                      "front_cornering_stiffness_N_per_rad": 1.4e5, "rear_cornering_stiffness_N_per_rad": 1.4e5})")
           .number("tire_width_m", &S::tire_width_m, "m", "tire section width (vehicle width = track + this)");
   return t;
 }

@@ -168,7 +168,8 @@ const FieldTable<Iso3888Settings>& Iso3888Settings::fields() {
           .custom("integrator", "-", "rk_merson 1e-6", "integrator settings",
                   [](const ParamReader& r, S& s) {
                     if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
-                  });
+                  })
+          .sample(R"({"method": "rk_merson", "accuracy": 1e-6})");
   return t;
 }
 
