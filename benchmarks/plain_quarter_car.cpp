@@ -55,7 +55,7 @@ PlainQuarterCar::PlainQuarterCar(const QuarterCarParams& qp) : matter_(system_),
                               p.spring_stiffness_N_per_m, p.spring_free_length_m);
   Force::TwoPointLinearDamper(forces_, chassis_, p.spring_chassis_point_m, lower, p.spring_arm_point_m,
                               p.damper_N_s_per_m);
-  Force::Custom(forces_, new TireForceImpl(wheel, makeTireModel(qp.tire_plugin, qp.tire), makeRoad(qp.road), spin));
+  Force::Custom(forces_, new TireForceImpl(wheel, makeTireModel(qp.tire.plugin, ParamReader::fromJson(qp.tire.params, qp.tire.where)), makeRoad(qp.road), spin));
   psi_ = Measure::Integrate(forces_, AzSquaredMeasure(forces_, chassis_), Measure::Zero(forces_));
   system_.realizeTopology();
 }

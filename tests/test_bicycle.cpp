@@ -30,7 +30,7 @@ TEST(Bicycle, ModelSize) {
 
 TEST(Bicycle, LinearTiresMatchTheLinearBicycleClosedForm) {
   BicycleParams p = nominal();
-  p.tire_plugin = "linear";
+  p.tire = p.tire.linearised();
   Bicycle bike(p);
   const double U = 10.0, delta = 0.5 * SimTK::Pi / 180;
   bike.addFrontSteering("front_steer", std::make_shared<SmoothStepCommand>(0.0, delta, 0.2, 0.5));
@@ -44,7 +44,7 @@ TEST(Bicycle, LinearTiresMatchTheLinearBicycleClosedForm) {
   const double r = bike.getScene().evalOutput("chassis.yaw_rate_rad_s", s);
   // Linear bicycle (6.1)-(6.9) with two tires per axle: C_f = C_r = 2 C_a.
   const double M = bike.totalMass(), a = bike.distanceToFrontAxle(), b = bike.distanceToRearAxle(), L = a + b;
-  const double C = 2 * p.tire.cornering_stiffness_N_per_rad;
+  const double C = 2 * p.tire.getNumber("cornering_stiffness_N_per_rad");
   const double rLinear = delta * U / (L + M * U * U / L * (b / C - a / C));
   std::printf("yaw rate: nonlinear bicycle %.6f rad/s, linear closed form %.6f rad/s (%.3f %%)\n", r, rLinear,
               100 * (r - rLinear) / rLinear);

@@ -132,7 +132,8 @@ Json withoutTimes(Json j) {
 }
 
 Json runWithTire(Json scene, const std::string& tire) {
-  scene["vehicle"]["overrides"]["tire"]["plugin"] = tire;
+  // The linear tires have no friction limit: mu keys removed where the block is (merge patch null).
+  scene["vehicle"]["overrides"]["tire"] = {{"plugin", tire}, {"params", {{"mu_max", nullptr}, {"mu_min", nullptr}}}};
   return withoutTimes(runScene(SceneDescription::fromJson(scene, "composition.json", registry())));
 }
 
@@ -207,7 +208,7 @@ TEST(Composition, LibraryTireInIso4138MatchesTheLinearBicycleClosedForm) {
   const BuiltScene b = d.build();
   const Bicycle& bk = b.vehicleAs<Bicycle>();
   const double M = bk.totalMass(), a = bk.distanceToFrontAxle(), bb = bk.distanceToRearAxle(), l = a + bb;
-  const double C = 2 * 2 * bk.params().tire.cornering_stiffness_N_per_rad;
+  const double C = 2 * 2 * LinearTireParams::fromParams(ParamReader::fromJson(bk.params().tire.params, "t")).cornering_stiffness_N_per_rad;
   const double K = M / l * (bb / C - a / C);
   const Json r = runScene(d);
   std::printf("library tire: understeer gradient %.6e rad/(m/s^2), closed form %.6e\n",

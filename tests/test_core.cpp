@@ -57,9 +57,9 @@ TEST(DataFile, NaNFromCodeIsNamed) {
   p.chassis_mass_kg = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(errorOf([&] { QuarterCar car(p); }), "quarter car chassis_mass_kg must be a finite number, got nan");
   p = parse(quarterCarJson());
-  p.tire.cornering_stiffness_N_per_rad = std::numeric_limits<double>::quiet_NaN();
+  p.tire.updNumber("cornering_stiffness_N_per_rad") = std::numeric_limits<double>::quiet_NaN();
   EXPECT_EQ(errorOf([&] { QuarterCar car(p); }),
-            "quarter car tire.cornering_stiffness_N_per_rad must be a finite number, got nan");
+            "qc.json: tire.params.cornering_stiffness_N_per_rad must be a finite number, got nan");
 }
 
 TEST(DataFile, UnknownTirePluginListsKnownOnes) {

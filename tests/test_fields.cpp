@@ -263,7 +263,7 @@ TEST(RegistryKeys, NestedObjectKeysAreListedWithTheirUnitsAndDefaults) {
     if (f.key == "params: radial_stiffness_N_per_m") {
       found = true;
       EXPECT_EQ(f.unit, "N/m");
-      EXPECT_EQ(Json::parse(f.default_value).get<double>(), TireParams{}.radial_stiffness_N_per_m);
+      EXPECT_EQ(Json::parse(f.default_value).get<double>(), TireVerticalParams{}.radial_stiffness_N_per_m);
     }
   EXPECT_TRUE(found);
 }

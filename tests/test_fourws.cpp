@@ -77,7 +77,7 @@ TEST(FourWs, InitialSpeedRollsTheWheels) {
 
 TEST(FourWs, UnknownTirePluginListsKnownOnes) {
   FourWsParams p = appendixA();
-  p.tire_plugin = "magic";
+  p.tire.plugin = "magic";
   try {
     FourWsVehicle car(p);
     FAIL() << "no error";

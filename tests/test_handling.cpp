@@ -47,7 +47,7 @@ TEST(Iso4138, LinearTireBicycleUndersteerGradientIsTheClosedForm) {
   // Linear bicycle (6.1)-(6.9), two tires per axle: delta_f = l / R + K a_y,
   // K = M / l (b / C_f - a / C_r).
   const double M = bk.totalMass(), a = bk.distanceToFrontAxle(), bb = bk.distanceToRearAxle(), l = a + bb;
-  const double C = 2 * bk.params().tire.cornering_stiffness_N_per_rad;
+  const double C = 2 * bk.params().tire.getNumber("cornering_stiffness_N_per_rad");
   const double K = M / l * (bb / C - a / C);
   std::printf("understeer gradient %.6e rad/(m/s^2) (closed form %.6e), delta at a_y = %.3f: %.6e (l/R + K a_y = %.6e)\n",
               r.understeer_gradient_linear_rad_per_m_s2, K, r.points[0].lateral_accel_m_s2, r.points[0].front_rad,

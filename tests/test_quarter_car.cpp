@@ -49,7 +49,7 @@ TEST(QuarterCar, StaticEquilibriumMatchesHandForceBalance) {
   const double Fz = sc.evalOutput("tire.Fz_N", s);
   // The solver's force tolerance (1e-6 N) bounds the imbalance.
   EXPECT_NEAR(Fz, W, 1e-6);
-  EXPECT_NEAR(sc.evalOutput("tire.deflection_m", s), W / car.params().tire.radial_stiffness_N_per_m, 1e-11);
+  EXPECT_NEAR(sc.evalOutput("tire.deflection_m", s), W / car.params().tire.getNumber("radial_stiffness_N_per_m"), 1e-11);
   // At rest the tangential tire forces vanish and nothing accelerates.
   EXPECT_NEAR(sc.evalOutput("tire.Fx_N", s), 0.0, 1e-9);
   EXPECT_NEAR(sc.evalOutput("tire.Fy_N", s), 0.0, 1e-9);
@@ -80,10 +80,10 @@ TEST(QuarterCar, EnergyIsConservedWithoutDampingOnAFlatRoad) {
   p.road.type = "flat";
   p.road.amplitude_m = 0;
   p.corner.damper_N_s_per_m = 0;
-  p.tire.radial_damping_N_s_per_m = 0;
   // No tangential tire forces: they dissipate whenever the patch slides.
-  p.tire.mu_max = p.tire.mu_min = 0;
-  p.tire.longitudinal_stiffness_N = p.tire.cornering_stiffness_N_per_rad = 0;
+  for (const char* k : {"radial_damping_N_s_per_m", "mu_max", "mu_min", "longitudinal_stiffness_N",
+                        "cornering_stiffness_N_per_rad"})
+    p.tire.params[k] = 0.0;
   QuarterCar car(p);
   SimTK::State s = car.makeInitialState(true);
   // Lift the chassis 1 cm from equilibrium and let it go.

@@ -235,14 +235,14 @@ TEST(Registry, EveryKindIsRegisteredAndDocumented) {
         EXPECT_FALSE(f.default_value.empty()) << type << " " << f.key;
       }
     }
-  // The tire's field table is TireParams::fields(): same keys, defaults of TireParams{}.
+  // The tire's field table is BrushTireParams::fields(): same keys, defaults of BrushTireParams{}.
   const TypeInfo& gim = r.info(PluginKind::ForceElement, "gim");
   bool found = false;
   for (const auto& f : gim.fields)
     if (f.key == "params: cornering_stiffness_N_per_rad") {
       found = true;
       EXPECT_EQ(f.unit, "N/rad");
-      EXPECT_EQ(std::stod(f.default_value), TireParams{}.cornering_stiffness_N_per_rad);
+      EXPECT_EQ(std::stod(f.default_value), BrushTireParams{}.cornering_stiffness_N_per_rad);
     }
   EXPECT_TRUE(found);
   EXPECT_EQ(errorOf([&] { r.createAnalysis("bogus", ParamReader::fromJson(Json::object(), "s"), "s.json: analysis.type"); })

@@ -211,8 +211,8 @@ TEST(Sensitivity, MixedRefinementUniformAndAdaptive) {
 
 QuarterCarParams relaxationQuarterCar() {
   QuarterCarParams q = QuarterCarParams::fromFile("quarter_car.json");
-  q.tire.relaxation_length_longitudinal_m = 0.25;
-  q.tire.relaxation_length_lateral_m = 0.5;
+  q.tire.params["relaxation_length_longitudinal_m"] = 0.25;
+  q.tire.params["relaxation_length_lateral_m"] = 0.5;
   return q;
 }
 

@@ -32,7 +32,8 @@ struct BikeCase {
 
 BikeCase makeBike(const std::string& tire, double U, double delta) {
   BicycleParams p = BicycleParams::fromFile("bicycle.json");
-  p.tire_plugin = tire;
+  if (tire == "linear") p.tire = p.tire.linearised();
+  else p.tire.plugin = tire;
   BikeCase c;
   c.bike = std::make_unique<Bicycle>(p);
   c.steer = std::make_shared<HoldCommand>(0.0);
@@ -54,7 +55,7 @@ LinearBicycleParams linearOf(const Bicycle& bike) {
   p.front_axle_to_com_m = bike.distanceToFrontAxle();
   p.rear_axle_to_com_m = bike.distanceToRearAxle();
   p.front_cornering_stiffness_N_per_rad = p.rear_cornering_stiffness_N_per_rad =
-      2 * bike.params().tire.cornering_stiffness_N_per_rad;
+      2 * bike.params().tire.getNumber("cornering_stiffness_N_per_rad");
   return p;
 }
 

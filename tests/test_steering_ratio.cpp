@@ -122,7 +122,7 @@ struct LinearFourWs {
 
   explicit LinearFourWs(double U) {
     FourWsParams p = FourWsParams::fromFile("appendix_a.json");
-    p.tire_plugin = "linear";
+    p.tire = p.tire.linearised();
     car = std::make_unique<FourWsVehicle>(p);
     car->addAxleSteering("front_steer", true, front);
     car->addAxleSteering("rear_steer", false, rear);
@@ -142,7 +142,7 @@ struct LinearFourWs {
     lin.front_axle_to_com_m = 0.5 * (wheelX(RF) + wheelX(LF)) - com[0];
     lin.rear_axle_to_com_m = com[0] - 0.5 * (wheelX(RR) + wheelX(LR));
     lin.front_cornering_stiffness_N_per_rad = lin.rear_cornering_stiffness_N_per_rad =
-        2 * p.tire.cornering_stiffness_N_per_rad;
+        2 * p.tire.getNumber("cornering_stiffness_N_per_rad");
   }
   SetSteering steer() {
     return [this](SimTK::State&, double f, double r) {

@@ -29,11 +29,18 @@ const std::vector<std::string> kSaturating = {"gim", "fiala"};
 const std::vector<std::string> kAll = {"gim", "fiala", "linear"};
 const std::vector<double> kLoads_N = {2000.0, 4000.0, 6000.0};
 
+/// Tire kind `type` with brush parameters p ("linear": their linearisation),
+/// built from its keys as the registry's factory builds it.
+std::shared_ptr<const TireModel> makeModel(const std::string& type, const BrushTireParams& p) {
+  const Json keys = type == "linear" ? LinearTireParams::linearised(p).toJson() : p.toJson();
+  return makeTireModel(type, ParamReader::fromJson(keys, "tire"));
+}
+
 /// Contact at normal load Fz (deflection Fz / Kz, zero deflection rate), forward
 /// speed vx, lateral speed vy and rolling speed vr = Omega Re (spin = vr / Re).
 ContactKinematics contact(const TireModel& m, double Fz, double vx, double vy, double vr) {
   ContactKinematics k;
-  k.deflection_m = Fz / m.params().radial_stiffness_N_per_m;
+  k.deflection_m = Fz / m.vertical().radial_stiffness_N_per_m;
   k.deflection_rate_m_s = 0;
   k.vx_m_s = vx;
   k.vy_m_s = vy;
@@ -67,10 +74,10 @@ std::vector<double> loads(const TireForces& f) { return {f.fx_N, f.fy_N, f.fz_N,
 // velocity h vx carries an absolute error of a few eps vx, i.e. a relative error
 // of a few eps / h = 1e-8 in the quotient. Both are well below the 1e-6 asked for.
 TEST(TireSlope, ZeroSlipSlopesEqualStiffnesses) {
-  const TireParams p;
+  const BrushTireParams p;
   const double h = 1e-8, vx = 10.0;
   for (const std::string& name : kAll) {
-    const auto m = makeTireModel(name, p);
+    const auto m = makeModel(name, p);
     for (double Fz : kLoads_N) {
       SCOPED_TRACE(name + " at Fz = " + std::to_string(Fz));
       const double fxPlus = m->calcForces(contact(*m, Fz, vx, 0, vx * (1 + h))).fx_N;
@@ -100,8 +107,8 @@ TEST(TireSlope, ZeroSlipSlopesEqualStiffnesses) {
 // S_s = (Omega Re - Vx) / (Omega Re) stays below 1 while Vx > 0 (2/3 at Omega Re = 3 Vx,
 // so mu = 0.8 - 0.2 * 2/3 there): fully sliding, but at mu(S) rather than mu_min.
 TEST(TireSaturation, GimResultantIsMuFzAtLargeSlip) {
-  const TireParams p;
-  const auto m = makeTireModel("gim", p);
+  const BrushTireParams p;
+  const auto m = makeModel("gim", p);
   const double vx = 10.0;
   struct Case {
     const char* what;
@@ -136,8 +143,8 @@ TEST(TireSaturation, GimResultantIsMuFzAtLargeSlip) {
 // the critical slip mu Fz / (2 C_s) = 0.0225 at 6000 N) the published law gives
 // Fx = -(mu Fz - (mu Fz)^2 / (4 C_s)) exactly (same operations: to 1e-12).
 TEST(TireSaturation, FialaLateralIsMuMinFzAndLockedWheelFollowsThePublishedLaw) {
-  const TireParams p;
-  const auto m = makeTireModel("fiala", p);
+  const BrushTireParams p;
+  const auto m = makeModel("fiala", p);
   const double vx = 10.0;
   for (double Fz : kLoads_N) {
     SCOPED_TRACE("Fz = " + std::to_string(Fz));
@@ -160,8 +167,8 @@ TEST(TireSaturation, FialaLateralIsMuMinFzAndLockedWheelFollowsThePublishedLaw) 
 // mu linear in S = |(S_s, S_a)|; l_n = 1 - |(C_s S_s, C_a S_a)| / (3 mu Fz) in [0, 1].
 // Only the operation order differs from the model (a few ulp): 1e-12 relative.
 TEST(TireGimCombined, MatchesTheSectionEightFormulas) {
-  const TireParams p;
-  const auto m = makeTireModel("gim", p);
+  const BrushTireParams p;
+  const auto m = makeModel("gim", p);
   const double Cs = p.longitudinal_stiffness_N, Ca = p.cornering_stiffness_N_per_rad;
   struct Case {
     double vx, vy, vr;
@@ -183,7 +190,7 @@ TEST(TireGimCombined, MatchesTheSectionEightFormulas) {
       const double Ss = driving ? (vr - c.vx) / vr : (c.vx - vr) / c.vx;
       const double Sa = driving ? (1 - Ss) * tanA : tanA;
       const double mu = p.mu_max - (p.mu_max - p.mu_min) * std::min(1.0, std::hypot(Ss, Sa));
-      const double FzModel = p.radial_stiffness_N_per_m * k.deflection_m;
+      const double FzModel = p.vertical.radial_stiffness_N_per_m * k.deflection_m;
       const double ln = std::clamp(1 - std::hypot(Cs * Ss, Ca * Sa) / (3 * mu * FzModel), 0.0, 1.0);
       const double theta = std::atan2(Ca * Sa, Cs * Ss);
       const double sliding = 1 - 3 * ln * ln + 2 * ln * ln * ln;
@@ -208,10 +215,10 @@ TEST(TireGimCombined, MatchesTheSectionEightFormulas) {
 TEST(TireGimFiala, EqualInPureLateralSlipWithConstantFriction) {
   const double vx = 10.0;
   for (double mu : {0.6, 0.8}) {
-    TireParams p;
+    BrushTireParams p;
     p.mu_max = p.mu_min = mu;
-    const auto gim = makeTireModel("gim", p);
-    const auto fiala = makeTireModel("fiala", p);
+    const auto gim = makeModel("gim", p);
+    const auto fiala = makeModel("fiala", p);
     for (double Fz : kLoads_N) {
       int sliding = 0;
       for (int i = 0; i <= 120; ++i) {
@@ -237,9 +244,9 @@ TEST(TireGimFiala, EqualInPureLateralSlipWithConstantFriction) {
 // negative when that slip component is nonzero; in all four quadrants of
 // (Vx - Omega Re, Vy), braking and driving, forward and reversing, at low speed.
 TEST(TireSign, ForcesOpposeTheSlipVelocity) {
-  const TireParams p;
+  const BrushTireParams p;
   for (const std::string& name : kSaturating) {
-    const auto m = makeTireModel(name, p);
+    const auto m = makeModel(name, p);
     int cases = 0;
     for (double vx : {10.0, -10.0, 0.2, -0.2, 0.0})
       for (double vr : {0.8 * vx, 1.2 * vx, -vx, 0.0, 0.3, -0.3, 12.0, -12.0, vx})
@@ -268,9 +275,9 @@ TEST(TireSign, ForcesOpposeTheSlipVelocity) {
 // forwards, mirrored. Both mirrors take the same floating-point path (only signs and
 // absolute values change), so the comparison is to 4 ulp.
 TEST(TireSign, MirrorSymmetry) {
-  const TireParams p;
+  const BrushTireParams p;
   for (const std::string& name : kAll) {
-    const auto m = makeTireModel(name, p);
+    const auto m = makeModel(name, p);
     for (double vx : {10.0, 1.0, 0.3, 0.0})
       for (double vr : {0.0, 0.5 * vx, vx, 1.5 * vx, 12.0, -3.0, 0.2})
         for (double vy : {0.5, 2.0, -0.1, 0.0}) {
@@ -291,9 +298,9 @@ TEST(TireSign, MirrorSymmetry) {
 
 // --- Off the ground, extreme kinematics ------------------------------------------------
 TEST(TireContact, ZeroForceOffTheGround) {
-  const TireParams p;
+  const BrushTireParams p;
   for (const std::string& name : kAll) {
-    const auto m = makeTireModel(name, p);
+    const auto m = makeModel(name, p);
     for (double d : {0.0, -0.0, -1e-12, -0.05, -1e300})
       for (double rate : {0.0, 100.0, -100.0}) {
         SCOPED_TRACE(name + ": deflection " + std::to_string(d) + ", rate " + std::to_string(rate));
@@ -314,11 +321,11 @@ TEST(TireContact, ZeroForceOffTheGround) {
 // capped at 3 R1: beyond it Re = R1 - delta / 3 < 0 and is not a tire any more.)
 // Up to 1e100 every output must also be finite.
 TEST(TireContact, NoNaNWithExtremeFiniteKinematics) {
-  const TireParams p;
-  const double R1 = p.unloaded_radius_m;
+  const BrushTireParams p;
+  const double R1 = p.vertical.unloaded_radius_m;
   const std::vector<double> v = {-1e300, -1e100, -1e10, -1, -1e-300, 0, 1e-300, 1e-9, 1, 1e10, 1e100, 1e300};
   for (const std::string& name : kAll) {
-    const auto m = makeTireModel(name, p);
+    const auto m = makeModel(name, p);
     long n = 0, nan = 0, nonFiniteModerate = 0;
     for (double d : {1e-300, 1e-12, 1e-3, 0.1, R1, 3 * R1})
       for (double rate : {-1e300, -1.0, 0.0, 1.0, 1e100, 1e300})
@@ -358,12 +365,12 @@ TEST(TireContact, NoNaNWithExtremeFiniteKinematics) {
 // a force by ~1.6e-4 N. A jump (a sign or branch discontinuity) would be of order
 // mu Fz ~ 1e3 N.
 TEST(TireContinuity, FiniteAndContinuousThroughStandstill) {
-  const TireParams p;
+  const BrushTireParams p;
   const double step = 1e-9;
   const std::vector<double> speeds = {-10, -1, -0.5, -0.3, -0.1, -1e-6, 0, 1e-6, 0.1, 0.3, 0.5, 1, 10};
   const std::vector<double> lateral = {-3, -0.5, -0.1, -1e-6, 0, 1e-6, 0.1, 0.5, 3};
   for (const std::string& name : kAll) {
-    const auto m = makeTireModel(name, p);
+    const auto m = makeModel(name, p);
     double worst = 0;
     std::string worstAt;
     for (double Fz : {500.0, 4000.0})
@@ -408,9 +415,9 @@ TEST(TireContinuity, FiniteAndContinuousThroughStandstill) {
 
 // --- Normal force and energy ------------------------------------------------------------
 TEST(TireNormal, SpringDamperClampedAtZeroAndItsEnergy) {
-  const TireParams p;
-  const auto m = makeTireModel("gim", p);
-  const double Kz = p.radial_stiffness_N_per_m, Cz = p.radial_damping_N_s_per_m;
+  const BrushTireParams p;
+  const auto m = makeModel("gim", p);
+  const double Kz = p.vertical.radial_stiffness_N_per_m, Cz = p.vertical.radial_damping_N_s_per_m;
   for (double d : {1e-6, 0.01, 0.02})
     for (double rate : {-1.0, -0.2, 0.0, 0.3, 2.0}) {
       ContactKinematics k;
@@ -439,7 +446,7 @@ TEST(TireNormal, SpringDamperClampedAtZeroAndItsEnergy) {
 
 // --- Errors ----------------------------------------------------------------------------
 TEST(TireErrors, NaNKinematicsNameTheField) {
-  const auto m = makeTireModel("gim", TireParams());
+  const auto m = makeModel("gim", BrushTireParams());
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
   const ContactKinematics good{0.02, 0.0, 10.0, 0.5, 33.0, 0.0};
@@ -467,66 +474,66 @@ TEST(TireErrors, NaNKinematicsNameTheField) {
 }
 
 TEST(TireErrors, NegativeCorneringStiffnessIsNamedWithItsValue) {
-  TireParams p;
+  BrushTireParams p;
   p.cornering_stiffness_N_per_rad = -1234.5;
   const std::string msg = errorOf([&] { p.validate("front tire"); });
   EXPECT_NE(msg.find("front tire.cornering_stiffness_N_per_rad"), std::string::npos) << msg;
   EXPECT_NE(msg.find("-1234.5"), std::string::npos) << msg;
   // The models validate their parameters on construction.
   EXPECT_THROW(GimTire tire(p), Error);
-  const std::string msg2 = errorOf([&] { makeTireModel("fiala", p); });
+  const std::string msg2 = errorOf([&] { makeModel("fiala", p); });
   EXPECT_NE(msg2.find("cornering_stiffness_N_per_rad"), std::string::npos) << msg2;
-  EXPECT_EQ(errorOf([] { TireParams().validate(); }), "(no error)");
+  EXPECT_EQ(errorOf([] { BrushTireParams().validate(); }), "(no error)");
 }
 
 TEST(TireErrors, UnknownModelListsKnownOnes) {
-  const std::string msg = errorOf([] { makeTireModel("foo", TireParams()); });
+  const std::string msg = errorOf([] { makeModel("foo", BrushTireParams()); });
   EXPECT_NE(msg.find("'foo'"), std::string::npos) << msg;
   EXPECT_NE(msg.find("fiala, gim, linear"), std::string::npos) << msg;
-  for (const std::string& name : kAll) EXPECT_NE(makeTireModel(name, TireParams()), nullptr) << name;
+  for (const std::string& name : kAll) EXPECT_NE(makeModel(name, BrushTireParams()), nullptr) << name;
 }
 
 TEST(TireErrors, UnknownParameterKeyIsNamed) {
   const Json j = {{"mu_max", 0.9}, {"cornering_stiffnes_N_per_rad", 5e4}};
-  const std::string msg = errorOf([&] { TireParams::fromParams(ParamReader::fromJson(j, "car.json: tire")); });
+  const std::string msg = errorOf([&] { BrushTireParams::fromParams(ParamReader::fromJson(j, "car.json: tire")); });
   EXPECT_NE(msg.find("cornering_stiffnes_N_per_rad"), std::string::npos) << msg;
   EXPECT_NE(msg.find("car.json: tire"), std::string::npos) << msg;
   EXPECT_NE(msg.find("unknown key (did you mean 'cornering_stiffness_N_per_rad'?)"), std::string::npos) << msg;
   // Known keys are read, missing keys keep the defaults.
-  const TireParams p = TireParams::fromParams(ParamReader::fromJson({{"mu_max", 0.9}}, "x"));
+  const BrushTireParams p = BrushTireParams::fromParams(ParamReader::fromJson({{"mu_max", 0.9}}, "x"));
   EXPECT_EQ(p.mu_max, 0.9);
-  EXPECT_EQ(p.cornering_stiffness_N_per_rad, TireParams().cornering_stiffness_N_per_rad);
+  EXPECT_EQ(p.cornering_stiffness_N_per_rad, BrushTireParams().cornering_stiffness_N_per_rad);
   // Values are range-checked through the same validate().
   const std::string msg3 = errorOf([] {
-    TireParams::fromParams(ParamReader::fromJson({{"longitudinal_stiffness_N", -2.0}}, "y"));
+    BrushTireParams::fromParams(ParamReader::fromJson({{"longitudinal_stiffness_N", -2.0}}, "y"));
   });
   EXPECT_NE(msg3.find("longitudinal_stiffness_N"), std::string::npos) << msg3;
 }
 
 // The defaults are Table A.4, the same as the App. A data file's tire.
-TEST(TireParamsData, DefaultsMatchAppendixA) {
-  const TireParams file =
-      TireParams::fromParams(ParamReader::fromFile("appendix_a.json").child("tire").child("params"));
-  const TireParams def;
+TEST(BrushTireParamsData, DefaultsMatchAppendixA) {
+  const BrushTireParams file =
+      BrushTireParams::fromParams(ParamReader::fromFile("appendix_a.json").child("tire").child("params"));
+  const BrushTireParams def;
   const Json defJson = def.toJson();
   for (const auto& [key, value] : defJson.items()) EXPECT_EQ(file.toJson().at(key), value) << key;
   // Relaxation is off by default (the seed's steady-slip tire); the variant
   // file based on appendix_a.json turns it on and changes nothing else.
-  EXPECT_FALSE(def.hasRelaxation());
-  const TireParams relaxed =
-      TireParams::fromParams(ParamReader::fromFile("appendix_a_relaxation.json").child("tire").child("params"));
-  EXPECT_EQ(relaxed.relaxation_length_longitudinal_m, 0.25);
-  EXPECT_EQ(relaxed.relaxation_length_lateral_m, 0.5);
-  EXPECT_EQ(relaxed.radial_stiffness_N_per_m, def.radial_stiffness_N_per_m);
+  EXPECT_FALSE(def.slip.hasRelaxation());
+  const BrushTireParams relaxed =
+      BrushTireParams::fromParams(ParamReader::fromFile("appendix_a_relaxation.json").child("tire").child("params"));
+  EXPECT_EQ(relaxed.slip.relaxation_length_longitudinal_m, 0.25);
+  EXPECT_EQ(relaxed.slip.relaxation_length_lateral_m, 0.5);
+  EXPECT_EQ(relaxed.vertical.radial_stiffness_N_per_m, def.vertical.radial_stiffness_N_per_m);
   EXPECT_EQ(relaxed.mu_min, def.mu_min);
-  EXPECT_EQ(def.unloaded_radius_m, 0.30);
-  EXPECT_EQ(def.radial_stiffness_N_per_m, 1.5e5);
+  EXPECT_EQ(def.vertical.unloaded_radius_m, 0.30);
+  EXPECT_EQ(def.vertical.radial_stiffness_N_per_m, 1.5e5);
   EXPECT_EQ(def.longitudinal_stiffness_N, 8.0e4);
   EXPECT_EQ(def.cornering_stiffness_N_per_rad, 7.0e4);
   EXPECT_EQ(def.mu_max, 0.80);
   EXPECT_EQ(def.mu_min, 0.60);
   // toJson / fromParams round trip.
-  const TireParams back = TireParams::fromParams(ParamReader::fromJson(def.toJson(), "rt"));
+  const BrushTireParams back = BrushTireParams::fromParams(ParamReader::fromJson(def.toJson(), "rt"));
   for (const auto& [key, value] : defJson.items()) EXPECT_EQ(back.toJson().at(key), value) << key;
 }
 
@@ -534,8 +541,8 @@ TEST(TireParamsData, DefaultsMatchAppendixA) {
 // Fy = -C_a atan(Vy / Vx) and Fx = C_s (Omega Re - Vx) / Vx exactly (the same
 // floating-point operations) above the low-speed threshold; no saturation.
 TEST(TireLinear, ForcesAreLinearInTheSlips) {
-  const TireParams p;
-  const auto m = makeTireModel("linear", p);
+  const BrushTireParams p;
+  const auto m = makeModel("linear", p);
   for (double vx : {0.6, 3.0, 10.0, 40.0})
     for (double vy : {-50.0, -1.0, -0.01, 0.0, 0.2, 7.0})
       for (double kappa : {-1.0, -0.05, 0.0, 0.3}) {
@@ -555,13 +562,13 @@ TEST(TireLinear, ForcesAreLinearInTheSlips) {
 // steady values kappa = (Omega Re - Vx) / |Vx|, tan alpha = Vy / |Vx| it must give
 // the steady-slip tire's forces exactly (driving, braking, both directions).
 TEST(TireRelaxation, TransientSlipAtItsSteadyValueGivesTheSteadyForces) {
-  TireParams p;
+  BrushTireParams p;
   p.camber_stiffness_N_per_rad = 2e3;
-  TireParams pr = p;
-  pr.relaxation_length_longitudinal_m = 0.25;
-  pr.relaxation_length_lateral_m = 0.5;
+  BrushTireParams pr = p;
+  pr.slip.relaxation_length_longitudinal_m = 0.25;
+  pr.slip.relaxation_length_lateral_m = 0.5;
   for (const char* type : {"gim", "fiala", "linear"}) {
-    const auto steady = makeTireModel(type, p), lag = makeTireModel(type, pr);
+    const auto steady = makeModel(type, p), lag = makeModel(type, pr);
     for (double vx : {10.0, -7.0, 25.0})
       for (double spinFactor : {0.9, 0.97, 1.0, 1.04, 1.3})
         for (double vy : {-1.5, -0.2, 0.0, 0.3, 4.0}) {
@@ -588,7 +595,7 @@ TEST(TireRelaxation, TransientSlipAtItsSteadyValueGivesTheSteadyForces) {
 }
 
 TEST(TireRelaxation, NegativeRelaxationLengthIsNamed) {
-  TireParams p;
-  p.relaxation_length_lateral_m = -0.1;
+  BrushTireParams p;
+  p.slip.relaxation_length_lateral_m = -0.1;
   EXPECT_EQ(errorOf([&] { p.validate("tire"); }), "tire.relaxation_length_lateral_m must not be negative, got -0.1");
 }

@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
           // minPoints angles (high speed); else the base grid.
           std::vector<double> grid = frontsDeg;
           {
-            const double ay = params.tire.mu_max * params.gravity_m_per_s2, klin = calcLinearOptimalRatio(lin, U);
+            const double ay = params.tire.getNumber("mu_max") * params.gravity_m_per_s2, klin = calcLinearOptimalRatio(lin, U);
             const double lim = ay * (lin.wheelbase_m() + lin.understeerGradient() * U * U) / (U * U * (1 - klin)) / kDeg;
             if (klin < 1 && lim > 0 && 0.8 * lim < fmin + (minPoints - 1) * fstep) {
               const double step = std::max(0.05, std::floor((0.8 * lim - fmin) / (minPoints - 1) / 0.05) * 0.05);

@@ -19,7 +19,7 @@
 #include <vector>
 
 #include "study.h"
-#include "vdyn/tire/tire_model.h"
+#include "vdyn/tire/tire_force.h"
 
 using namespace vdyn;
 
@@ -36,7 +36,7 @@ const int kKappaPoints = 201;  // -1 .. 1, 0.01 apart
 /// Forces at load Fz, lateral slip tan(alpha) and slip ratio kappa (vx = 10 m/s).
 TireForces evaluate(const TireModel& m, double Fz, double tanAlpha, double kappa) {
   ContactKinematics k;
-  k.deflection_m = Fz / m.params().radial_stiffness_N_per_m;
+  k.deflection_m = calcStaticDeflection(m, Fz);
   k.deflection_rate_m_s = 0;
   k.vx_m_s = kVx_m_s;
   k.vy_m_s = kVx_m_s * tanAlpha;
@@ -93,13 +93,14 @@ int main(int argc, char** argv) {
                                  argc, argv, opts);
     const std::string dataFile = vm["data"].as<std::string>();
     const ParamReader data = ParamReader::fromFile(dataFile);
-    const TireParams params = TireParams::fromParams(data.child("tire").child("params"));
+    const BrushTireParams params = BrushTireParams::fromParams(data.child("tire").child("params"));
     data.child("tire").has("plugin");  // the vehicle's tire plugin: the curves show every model
     data.child("tire").requireAllKeysRead();
     const std::string out = study::outputDir(vm, "tire_curves");
 
     std::map<std::string, std::shared_ptr<const TireModel>> models;
-    for (const std::string& name : kModels) models[name] = makeTireModel(name, params);
+    models["gim"] = std::make_shared<GimTire>(params);  // kModels: the brush tires, same keys
+    models["fiala"] = std::make_shared<FialaTire>(params);
 
     // --- Pure lateral slip --------------------------------------------------------
     // lateral.csv (long format) and lateral_plot.csv (one column per model and load).

@@ -40,7 +40,8 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     const Json j = parseJsonText(text, "fuzz.json");
     if (!j.is_object()) return;
     const ParamReader r = ParamReader::fromJson(j, "fuzz.json");
-    guarded([&] { TireParams::fromParams(r); });
+    guarded([&] { BrushTireParams::fromParams(r); });
+    guarded([&] { LinearTireParams::fromParams(r); });
     guarded([&] { if (r.has("road")) RoadParams::fromParams(r.child("road")); });
     guarded([&] { if (r.has("integrator")) IntegratorSettings::fromParams(r.child("integrator")); });
     guarded([&] { if (r.has("chassis")) RigidBodyParams::fromParams(r.child("chassis")); });

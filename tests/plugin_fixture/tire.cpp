@@ -10,6 +10,14 @@
 
 namespace {
 const double kCorneringScale = 2.0, kRadialScale = 1.5;
+
+/// params[key], or the linear tire's default as its registered field table lists it.
+double valueOr(const vdyn::Json& params, const std::string& key, const vdyn::PluginRegistry& registry) {
+  if (params.contains(key)) return params.at(key).get<double>();
+  for (const auto& f : registry.info(vdyn::PluginKind::ForceElement, "linear").fields)
+    if (f.key == "params: " + key) return std::stod(f.default_value);
+  throw vdyn::Error("fixture_stiff_linear: the linear tire lists no key '" + key + "'");
+}
 }  // namespace
 
 VDYN_PLUGIN_EXPORT int vdyn_plugin_abi_version() { return VDYN_PLUGIN_ABI_VERSION; }
@@ -22,8 +30,8 @@ VDYN_PLUGIN_EXPORT void vdyn_register_plugins(vdyn::PluginRegistry& registry) {
         vdyn::Json j = spec.params.json();
         spec.params.markAllRead();
         vdyn::Json& p = j["params"];
-        p["cornering_stiffness_N_per_rad"] = kCorneringScale * p.at("cornering_stiffness_N_per_rad").get<double>();
-        p["radial_stiffness_N_per_m"] = kRadialScale * p.at("radial_stiffness_N_per_m").get<double>();
+        p["cornering_stiffness_N_per_rad"] = kCorneringScale * valueOr(p, "cornering_stiffness_N_per_rad", *reg);
+        p["radial_stiffness_N_per_m"] = kRadialScale * valueOr(p, "radial_stiffness_N_per_m", *reg);
         const vdyn::PluginSpec linear{spec.name, vdyn::ParamReader::fromJson(j, spec.params.where()), spec.bindings,
                                       spec.registry};
         return reg->create(vdyn::PluginKind::ForceElement, "linear", linear, spec.params.where());

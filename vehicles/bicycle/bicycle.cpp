@@ -19,7 +19,6 @@ void BicycleParams::validate() const {
   if (!(front_axle_m[0] > rear_axle_m[0]))
     throw Error("bicycle front axle must lie ahead of the rear axle, got x = " + formatValue(front_axle_m[0]) +
                 " and " + formatValue(rear_axle_m[0]));
-  tire.validate("bicycle tire");
   makeRoad(road);
   requireNonNegative(gravity_m_per_s2, "bicycle gravity_m_per_s2");
 }
@@ -57,17 +56,14 @@ const FieldTable<BicycleParams>& BicycleParams::fields() {
                     p.rear_track_m = -2 * wr[1];
                     p.front_axle = lumpAxle(front, p.front_track_m);
                     p.rear_axle = lumpAxle(rear, p.rear_track_m);
-                    // The vehicle data's tire, with this file's "tire" merged over it.
-                    const ParamReader tire = v.child("tire");
-                    p.tire_plugin = tire.string("plugin");
-                    ParamReader tireParams = tire.child("params");
+                    // The vehicle data's tire, with this file's "tire" over it.
                     if (r.has("tire")) {
                       const ParamReader t = r.child("tire");
-                      p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
-                      if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
+                      p.tire = TireChoice::fromParams(v.child("tire"), &t);
+                    } else {
+                      p.tire = TireChoice::fromParams(v.child("tire"));
                     }
-                    p.tire = TireParams::fromParams(tireParams);
-                    for (const char* k : {"chassis", "front_right", "rear_right", "tire"}) v.child(k).requireAllKeysRead();
+                    for (const char* k : {"chassis", "front_right", "rear_right"}) v.child(k).requireAllKeysRead();
                   })
           .sample("\"appendix_a.json\"")
           .custom("fork", "-", "required", "rigid body of the steered fork",
@@ -112,17 +108,16 @@ Bicycle::Bicycle(const BicycleParams& params, const PluginRegistry& registry)
   sc.addBody("front_axle", front_);
   sc.addBody("rear_axle", rear_);
   sc.setService<const Road>("road", makeRoad(p_.road));
-  const Json tireJson = p_.tire.toJson();
   struct Spec { const char* name; const char* body; double y; };
   const Spec specs[4] = {{"tire_fr", "front_axle", -p_.front_track_m / 2}, {"tire_fl", "front_axle", p_.front_track_m / 2},
                          {"tire_rr", "rear_axle", -p_.rear_track_m / 2}, {"tire_rl", "rear_axle", p_.rear_track_m / 2}};
   for (const Spec& t : specs) {
     // Both tires of an axle take the slip of the axle centre (see bicycle.h).
-    const Json j{{"params", tireJson}, {"centre_m", {0.0, t.y, 0.0}}, {"slip_centre_m", {0.0, 0.0, 0.0}}};
-    const PluginSpec spec{t.name, ParamReader::fromJson(j, "bicycle tire"), {{"wheel", t.body}}};
+    const Json entry{{"centre_m", {0.0, t.y, 0.0}}, {"slip_centre_m", {0.0, 0.0, 0.0}}};
+    const PluginSpec spec = p_.tire.makeSpec(t.name, t.body, entry);
     tires_.push_back(dynamic_cast<const TirePlugin*>(
-        &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire_plugin, spec, "bicycle tire plugin"))));
-    if (!tires_.back()) throw Error("bicycle tire plugin '" + p_.tire_plugin + "' is not a tire plugin");
+        &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire.plugin, spec, "bicycle tire plugin"))));
+    if (!tires_.back()) throw Error("bicycle tire plugin '" + p_.tire.plugin + "' is not a tire plugin");
   }
   const auto f = front_, r = rear_;
   sc.addOutput({"front_axle.spin_rad_s", "rad/s", SimTK::Stage::Velocity, [f](const SimTK::State& s) { return f.getOneU(s, 0); }});
@@ -164,10 +159,11 @@ SimTK::State Bicycle::makeInitialState(double speed) const {
   requireFinite(speed, "bicycle initial speed_m_s");
   const SimTK::MultibodySystem& system = scene_->getSystem();
   SimTK::State s = scene_->getDefaultState();
-  const double deflection = totalMass() * p_.gravity_m_per_s2 / 4 / p_.tire.radial_stiffness_N_per_m;
+  const TireModel& tire = tires_[0]->getModel();
+  const double deflection = calcStaticDeflection(tire, totalMass() * p_.gravity_m_per_s2 / 4);
   const double road0 = makeRoad(p_.road)->height(0, 0, 0);
   const double zAxle = 0.5 * (p_.front_axle_m[2] + p_.rear_axle_m[2]);
-  chassis_.setQToFitTranslation(s, Vec3(0, 0, road0 + p_.tire.unloaded_radius_m - deflection - zAxle));
+  chassis_.setQToFitTranslation(s, Vec3(0, 0, road0 + tire.vertical().unloaded_radius_m - deflection - zAxle));
   system.realize(s, SimTK::Stage::Position);
   if (s.getQErr().size() > 0 && s.getQErr().normInf() > 1e-12) {
     SimTK::Assembler assembler(system);

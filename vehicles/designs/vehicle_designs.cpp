@@ -26,7 +26,7 @@ static std::vector<FieldHandle<QuarterCarParams>> quarterCarHandles() {
       {{"corner.spring.damping_N_s_per_m", "D", "N s/m", 0, 1e3},
        [](P& p) -> double& { return p.corner.damper_N_s_per_m; }},
       {{"tire.radial_stiffness_N_per_m", "Cz", "N/m", 0, 1e5},
-       [](P& p) -> double& { return p.tire.radial_stiffness_N_per_m; }},
+       [](P& p) -> double& { return p.tire.updNumber("radial_stiffness_N_per_m"); }},
       // s' = 0 nominal: perturbations scale with 0.01 m.
       {{"upper_pivot_offset_m", "s'", "m", 0, 0.01}, [](P& p) -> double& { return p.upper_pivot_offset_m; }},
       // More for the scaling study (20 in all).
@@ -52,9 +52,9 @@ static std::vector<FieldHandle<QuarterCarParams>> quarterCarHandles() {
       {{"corner.spring.chassis_point_m[2]", "", "m", 0, 0.1},
        [](P& p) -> double& { return p.corner.spring_chassis_point_m[2]; }},
       {{"tire.radial_damping_N_s_per_m", "", "N s/m", 0, 100},
-       [](P& p) -> double& { return p.tire.radial_damping_N_s_per_m; }},
+       [](P& p) -> double& { return p.tire.updNumber("radial_damping_N_s_per_m"); }},
       {{"tire.cornering_stiffness_N_per_rad", "", "N/rad", 0, 1e4},
-       [](P& p) -> double& { return p.tire.cornering_stiffness_N_per_rad; }},
+       [](P& p) -> double& { return p.tire.updNumber("cornering_stiffness_N_per_rad"); }},
   };
   for (auto& f : h)
     if (f.param.symbol.empty()) f.param.symbol = f.param.name;

@@ -22,10 +22,9 @@ void FourWsParams::validate() const {
   chassis.validate("4ws chassis");
   front_right.validate("4ws front_right");
   rear_right.validate("4ws rear_right");
-  tire.validate("4ws tire");
   makeRoad(road);
   requireNonNegative(gravity_m_per_s2, "4ws gravity_m_per_s2");
-  if (tire_plugin.empty()) throw Error("4ws tire plugin name is empty");
+  if (tire.plugin.empty()) throw Error("4ws tire plugin name is empty");
   if (corner_model != "constrained" && corner_model != "reduced")
     throw Error("4ws corner_model must be \"constrained\" or \"reduced\", got \"" + corner_model + "\"");
   if (forward_dynamics != "simbody" && forward_dynamics != "dense")
@@ -50,11 +49,7 @@ const FieldTable<FourWsParams>& FourWsParams::fields() {
                   })
           .custom("tire", "-", "required",
                   "{\"plugin\": gim|fiala|linear|..., \"params\": {the tire's 'params: ...' keys (vdyn list gim)}}",
-                  [](const ParamReader& r, P& p) {
-                    const ParamReader tire = r.child("tire");
-                    p.tire_plugin = tire.string("plugin");
-                    p.tire = TireParams::fromParams(tire.child("params"));
-                  })
+                  [](const ParamReader& r, P& p) { p.tire = TireChoice::fromParams(r.child("tire")); })
           .custom("road", "-", "{\"type\": \"flat\"}", "road: {\"type\": flat|sine, ...}",
                   [](const ParamReader& r, P& p) {
                     if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
@@ -95,7 +90,6 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
   sc.addBody("chassis", chassis_);
   cornerParams_ = {p_.front_right, p_.front_right.mirrored(), p_.rear_right, p_.rear_right.mirrored()};
   sc.setService<const Road>("road", makeRoad(p_.road));
-  const Json tireJson = p_.tire.toJson();
   for (int c = 0; c < 4; ++c) {
     const std::string prefix = std::string(cornerName(c)) + ".";
     if (reduced_) {
@@ -104,12 +98,10 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
     } else {
       corners_[c] = buildDoubleWishbone(sc, chassis_, cornerParams_[c], prefix);
     }
-    const PluginSpec spec{std::string("tire_") + cornerName(c),
-                          ParamReader::fromJson(Json{{"params", tireJson}}, "4ws tire"),
-                          {{"wheel", prefix + "wheel"}}};
+    const PluginSpec spec = p_.tire.makeSpec(std::string("tire_") + cornerName(c), prefix + "wheel");
     tires_[c] = dynamic_cast<const TirePlugin*>(
-        &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire_plugin, spec, "4ws tire plugin")));
-    if (!tires_[c]) throw Error("4ws tire plugin '" + p_.tire_plugin + "' is not a tire plugin");
+        &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire.plugin, spec, "4ws tire plugin")));
+    if (!tires_[c]) throw Error("4ws tire plugin '" + p_.tire.plugin + "' is not a tire plugin");
     const SimTK::MobilizedBody wheel = sc.getBody(prefix + "wheel");
     sc.addOutput({prefix + "spin_rad_s", "rad/s", SimTK::Stage::Velocity,
                   [wheel](const SimTK::State& s) { return wheel.getOneU(s, 0); }});
@@ -166,10 +158,11 @@ SimTK::State FourWsVehicle::makeInitialState(double speed, AssemblyReport* repor
   const SimTK::MultibodySystem& system = scene_->getSystem();
   SimTK::State s = scene_->getDefaultState();
   const double road0 = makeRoad(p_.road)->height(0, 0, 0);
-  const double deflection = totalMass() * p_.gravity_m_per_s2 / 4 / p_.tire.radial_stiffness_N_per_m;
+  const TireModel& tire = tires_[0]->getModel();
+  const double deflection = calcStaticDeflection(tire, totalMass() * p_.gravity_m_per_s2 / 4);
   double wcz = 0;
   for (const auto& c : cornerParams_) wcz += wheelCentreInChassis(c)[2] / 4;
-  chassis_.setQToFitTranslation(s, Vec3(0, 0, road0 + p_.tire.unloaded_radius_m - deflection - wcz));
+  chassis_.setQToFitTranslation(s, Vec3(0, 0, road0 + tire.vertical().unloaded_radius_m - deflection - wcz));
   system.realize(s, SimTK::Stage::Position);
 
   std::vector<std::pair<std::string, SimTK::MobilizedBody>> bodies;

@@ -11,11 +11,10 @@ using SimTK::Vec3;
 void QuarterCarParams::validate() const {
   requirePositive(chassis_mass_kg, "quarter car chassis_mass_kg");
   corner.validate("quarter car corner");
-  tire.validate("quarter car tire");
   makeRoad(road);
   requireFinite(upper_pivot_offset_m, "quarter car upper_pivot_offset_m");
   requireNonNegative(gravity_m_per_s2, "quarter car gravity_m_per_s2");
-  if (tire_plugin.empty()) throw Error("quarter car tire plugin name is empty");
+  if (tire.plugin.empty()) throw Error("quarter car tire plugin name is empty");
 }
 
 const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
@@ -34,16 +33,12 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
                     if (r.has("corner_overrides")) corner = corner.mergedWith(r.child("corner_overrides"));
                     p.corner = DoubleWishboneParams::fromParams(corner);
                     corner.requireAllKeysRead();
-                    const ParamReader tire = vehicle.child("tire");
-                    p.tire_plugin = tire.string("plugin");
-                    ParamReader tireParams = tire.child("params");
                     if (r.has("tire")) {
                       const ParamReader t = r.child("tire");
-                      p.tire_plugin = t.stringOr("plugin", p.tire_plugin);
-                      if (t.has("params")) tireParams = tireParams.mergedWith(t.child("params"));
+                      p.tire = TireChoice::fromParams(vehicle.child("tire"), &t);
+                    } else {
+                      p.tire = TireChoice::fromParams(vehicle.child("tire"));
                     }
-                    p.tire = TireParams::fromParams(tireParams);
-                    tire.requireAllKeysRead();
                   })
           .sample("\"appendix_a.json\"")
           .custom("corner", "-", "\"front_right\"", "which corner of the vehicle data (read with vehicle_data)",
@@ -130,11 +125,9 @@ QuarterCar::QuarterCar(const QuarterCarParams& params, const PluginRegistry& reg
 
   auto road = makeRoad(p_.road);
   sc.setService<const Road>("road", road);
-  const PluginSpec spec{"tire", ParamReader::fromJson(Json{{"params", p_.tire.toJson()}}, "quarter car tire"),
-                        {{"wheel", "wheel"}}};
-  tire_ = dynamic_cast<const TirePlugin*>(
-      &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire_plugin, spec, "quarter car tire plugin")));
-  if (!tire_) throw Error("quarter car tire plugin '" + p_.tire_plugin + "' is not a tire plugin");
+  tire_ = dynamic_cast<const TirePlugin*>(&sc.addPlugin(
+      registry.create(PluginKind::ForceElement, p_.tire.plugin, p_.tire.makeSpec("tire", "wheel"), "quarter car tire plugin")));
+  if (!tire_) throw Error("quarter car tire plugin '" + p_.tire.plugin + "' is not a tire plugin");
 
   const auto c = chassis_;
   const auto w = corner_.wheel;
@@ -173,8 +166,8 @@ SimTK::State QuarterCar::makeInitialState(bool equilibrium, AssemblyReport* repo
   // Chassis height so that the tire carries roughly the weight in the tabulated configuration.
   const Vec3 wc = wheelCentreInChassis(p_.corner);
   const double road0 = makeRoad(p_.road)->height(0, 0, 0);
-  const double sag = totalMass() * p_.gravity_m_per_s2 / p_.tire.radial_stiffness_N_per_m;
-  chassis_.setOneQ(s, 0, road0 + p_.tire.unloaded_radius_m - wc[2] - sag);
+  const double sag = calcStaticDeflection(tire_->getModel(), totalMass() * p_.gravity_m_per_s2);
+  chassis_.setOneQ(s, 0, road0 + tire_->getModel().vertical().unloaded_radius_m - wc[2] - sag);
   system.realize(s, SimTK::Stage::Position);
 
   const std::vector<std::pair<std::string, SimTK::MobilizedBody>> bodies = {

@@ -41,7 +41,7 @@ TireForceImpl::Geometry TireForceImpl::calcGeometry(const SimTK::State& s) const
   const double len = down.norm();
   if (len < 1e-9) return g;  // wheel lying flat on the road: no rolling contact
   down /= len;
-  const TireParams& p = model_->params();
+  const TireVerticalParams& p = model_->vertical();
   const Vec3 p_GC0 = p_GW + (p.unloaded_radius_m - p.carcass_radius_m) * down;  // carcass centre
   const double h = road_->height(p_GC0[0], p_GC0[1], t);
   const double clearance = (p_GC0[2] - h) * n[2];  // height of C0 above the road along n
@@ -65,12 +65,12 @@ TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
   TireContact c = calcContactKinematics(s);
   if (!c.in_contact) return c;
   if (hasRelaxationStates()) {
-    const TireParams& p = model_->params();
     const SimTK::Vector& z = zSub_->getZ(s);
     ContactKinematics& k = c.kinematics;
+    const auto [sigmaX, sigmaY] = model_->calcRelaxationLengths(model_->calcNormalForce(k));
     k.transient_slip = true;
-    if (p.relaxation_length_longitudinal_m > 0) k.kappa = -z[z0_] / p.relaxation_length_longitudinal_m;
-    if (p.relaxation_length_lateral_m > 0) k.tan_alpha = z[z0_ + 1] / p.relaxation_length_lateral_m;
+    if (sigmaX > 0) k.kappa = -z[z0_] / sigmaX;
+    if (sigmaY > 0) k.tan_alpha = z[z0_ + 1] / sigmaY;
   }
   c.forces = model_->calcForces(c.kinematics);
   return c;
@@ -79,8 +79,8 @@ TireContact TireForceImpl::calcContact(const SimTK::State& s) const {
 SimTK::Vec2 TireForceImpl::calcRelaxationRates(const SimTK::State& s) const {
   SimTK::Vec2 rate(0);
   if (!hasRelaxationStates()) return rate;
-  const TireParams& p = model_->params();
   const TireContact c = calcContactKinematics(s);
+  const auto [sigmaX, sigmaY] = model_->calcRelaxationLengths(model_->calcNormalForce(c.kinematics));
   const SimTK::Vector& z = zSub_->getZ(s);
   // du/dt = v_slip - |Vx| u / sigma: the patch follows the slip displacement
   // and relaxes to u = sigma v_slip / |Vx| (Pacejka's first-order transient).
@@ -89,8 +89,8 @@ SimTK::Vec2 TireForceImpl::calcRelaxationRates(const SimTK::State& s) const {
   const double V = std::abs(k.vx_m_s);
   const double vsx = c.in_contact ? k.vx_m_s - k.spin_rad_s * model_->calcRollingRadius(k.deflection_m) : 0.0;
   const double vsy = c.in_contact ? k.vy_m_s : 0.0;
-  if (p.relaxation_length_longitudinal_m > 0) rate[0] = vsx - V * z[z0_] / p.relaxation_length_longitudinal_m;
-  if (p.relaxation_length_lateral_m > 0) rate[1] = vsy - V * z[z0_ + 1] / p.relaxation_length_lateral_m;
+  if (sigmaX > 0) rate[0] = vsx - V * z[z0_] / sigmaX;
+  if (sigmaY > 0) rate[1] = vsy - V * z[z0_ + 1] / sigmaY;
   return rate;
 }
 
@@ -104,15 +104,15 @@ void TireForceImpl::realizeDynamics(const SimTK::State& s) const {
 
 void TireForceImpl::initializeRelaxationStates(SimTK::State& s) const {
   if (!hasRelaxationStates()) return;
-  const TireParams& p = model_->params();
   const TireContact c = calcContactKinematics(s);
   const ContactKinematics& k = c.kinematics;
-  const double den = std::max(std::abs(k.vx_m_s), p.low_speed_threshold_m_s);
+  const auto [sigmaX, sigmaY] = model_->calcRelaxationLengths(model_->calcNormalForce(k));
+  const double den = std::max(std::abs(k.vx_m_s), model_->slip().low_speed_threshold_m_s);
   const double vsx = c.in_contact ? k.vx_m_s - k.spin_rad_s * model_->calcRollingRadius(k.deflection_m) : 0.0;
   const double vsy = c.in_contact ? k.vy_m_s : 0.0;
   SimTK::Vector& z = zSub_->updZ(s);
-  z[z0_] = p.relaxation_length_longitudinal_m * vsx / den;
-  z[z0_ + 1] = p.relaxation_length_lateral_m * vsy / den;
+  z[z0_] = sigmaX * vsx / den;
+  z[z0_ + 1] = sigmaY * vsy / den;
 }
 
 TireContact TireForceImpl::calcContactKinematics(const SimTK::State& s) const {
@@ -205,59 +205,132 @@ void TirePlugin::DoAddTo(Scene& scene) {
   add("slip_angle_rad", "rad", [](const TireContact& c) { return c.forces.slip_angle_rad; });
 }
 
+TireChoice TireChoice::fromParams(const ParamReader& base, const ParamReader* overrides) {
+  TireChoice c;
+  c.plugin = base.string("plugin");
+  c.where = base.where();
+  ParamReader params = base.has("params") ? base.child("params") : ParamReader::fromJson(Json::object(), base.where() + ".params");
+  if (overrides) {
+    const std::string kind = overrides->stringOr("plugin", c.plugin);
+    if (kind != c.plugin) {  // another kind: the base's params are another kind's keys
+      params.markAllRead();
+      params = ParamReader::fromJson(Json::object(), overrides->where() + ".params");
+      c.where = overrides->where();
+    }
+    c.plugin = kind;
+    if (overrides->has("params")) {
+      params = params.mergedWith(overrides->child("params"));
+      c.where = overrides->where();
+    }
+    overrides->requireAllKeysRead();
+  }
+  if (c.plugin.empty()) throw Error(c.where + ".plugin: empty tire plugin name");
+  if (!params.json().is_object()) throw Error(c.where + ".params: must be an object");
+  c.params = params.json();
+  params.markAllRead();  // read by the kind's factory when the vehicle adds the tire
+  base.requireAllKeysRead();
+  return c;
+}
+
+double& TireChoice::updNumber(const std::string& key) {
+  auto it = params.find(key);
+  if (it == params.end() || !it->is_number())
+    throw Error(where + ".params." + key + ": a design parameter needs this number given in the tire's params");
+  if (!it->is_number_float()) *it = it->get<double>();
+  return it->get_ref<double&>();
+}
+
+TireChoice TireChoice::linearised() const {
+  if (plugin != "gim" && plugin != "fiala")
+    throw Error(where + ".plugin: only a brush tire (gim, fiala) has a linearisation, got '" + plugin + "'");
+  TireChoice c = *this;
+  c.plugin = "linear";
+  c.params = LinearTireParams::linearised(BrushTireParams::fromParams(ParamReader::fromJson(params, where + ".params")))
+                 .toJson();
+  return c;
+}
+
+double TireChoice::getNumber(const std::string& key) const {
+  auto it = params.find(key);
+  if (it != params.end() && it->is_number()) return it->get<double>();
+  if (it == params.end()) {  // a built-in kind's default
+    std::vector<FieldInfo> fields;
+    if (plugin == "gim" || plugin == "fiala") fields = BrushTireParams::fields().describe();
+    if (plugin == "linear") fields = LinearTireParams::fields().describe();
+    for (const FieldInfo& f : fields)
+      if (f.key == key) return Json::parse(f.default_value).get<double>();
+  }
+  throw Error(where + ".params." + key + ": not a number of tire '" + plugin + "'");
+}
+
+PluginSpec TireChoice::makeSpec(const std::string& name, const std::string& wheel, const Json& entry) const {
+  // Read as the data file's block: the factory's messages name where.params.KEY.
+  Json j = entry;
+  j["params"] = params;
+  auto root = std::make_shared<const Json>(std::move(j));
+  return PluginSpec{name, ParamReader(root, root.get(), where), {{"wheel", wheel}}};
+}
+
+double calcStaticDeflection(const TireModel& model, double fz) { return fz / model.vertical().radial_stiffness_N_per_m; }
+
 namespace {
-/// The keys of a tire plugin entry (every tire kind).
+/// The keys of a tire plugin entry: where the tire sits, and its kind's params P.
+template <class P>
 struct TireSpec {
   std::string wheel;
   SimTK::Vec3 spin_axis{0, 1, 0};
   SimTK::Vec3 centre_m{0, 0, 0};
   bool has_slip_centre = false;
   SimTK::Vec3 slip_centre_m{0, 0, 0};
-  TireParams params;
+  P params;
 };
-const FieldTable<TireSpec>& tireSpecFields() {
+template <class P>
+const FieldTable<TireSpec<P>>& tireSpecFields() {
+  using S = TireSpec<P>;
   static const auto t =
-      FieldTable<TireSpec>()
+      FieldTable<S>()
           .custom("wheel", "-", "required", "wheel body (bindable: attach a corner)",
-                  [](const ParamReader& r, TireSpec& s) { if (r.has("wheel")) s.wheel = r.string("wheel"); })
+                  [](const ParamReader& r, S& s) { if (r.has("wheel")) s.wheel = r.string("wheel"); })
           .sample("\"wheel\"")
-          .vec3("spin_axis", &TireSpec::spin_axis, "-", "spin axis in the wheel frame")
-          .vec3("centre_m", &TireSpec::centre_m, "m", "tire centre on the wheel's spin axis, wheel frame")
+          .vec3("spin_axis", &S::spin_axis, "-", "spin axis in the wheel frame")
+          .vec3("centre_m", &S::centre_m, "m", "tire centre on the wheel's spin axis, wheel frame")
           .custom("slip_centre_m", "m", "centre_m", "where slip velocities are taken, wheel frame",
-                  [](const ParamReader& r, TireSpec& s) {
+                  [](const ParamReader& r, S& s) {
                     s.has_slip_centre = r.has("slip_centre_m");
                     if (s.has_slip_centre) s.slip_centre_m = r.vec3("slip_centre_m");
                   })
           .sample("[0, 0, 0]")
-          .object("params", &TireSpec::params, TireParams::fields(), "tire parameters (the keys 'params: ...')");
+          .object("params", &S::params, P::fields(), "tire parameters (the keys 'params: ...')");
   return t;
+}
+
+/// Registers tire kind `type` with parameter struct P and model class M.
+template <class P, class M>
+void registerTireKind(PluginRegistry& registry, const std::string& type, const std::string& summary) {
+  registry.add(
+      PluginKind::ForceElement, type,
+      [type](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+        const TireSpec<P> s = tireSpecFields<P>().read(spec.params);
+        if (spec.params.has("params")) {
+          const ParamReader p = spec.params.child("params");
+          p.requireAllKeysRead();  // an unknown tire key is an error, with the nearest key as a hint
+          s.params.validate(p.where());
+        }
+        auto plugin = std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"), std::make_shared<M>(s.params),
+                                                   SimTK::UnitVec3(s.spin_axis), "road", s.centre_m);
+        if (s.has_slip_centre) plugin->setSlipCentre(s.slip_centre_m);
+        return plugin;
+      },
+      typeInfo(summary + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad", tireSpecFields<P>()));
 }
 }  // namespace
 
 void registerTirePlugins(PluginRegistry& registry) {
-  static const char* summaries[3][2] = {
-      {"gim", "the seed's analytical comprehensive-slip tire (Gim and Nikravesh) on a wheel body"},
-      {"fiala", "the Fiala tire as published, on a wheel body"},
-      {"linear", "linear tire Fx = C_s kappa, Fy = -C_a alpha (no saturation), on a wheel body"}};
-  for (const auto& [type, summary] : summaries) {
-    const std::string t = type;
-    registry.add(
-        PluginKind::ForceElement, t,
-        [t](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-          const TireSpec s = tireSpecFields().read(spec.params);
-          if (spec.params.has("params")) {
-            const ParamReader p = spec.params.child("params");
-            p.requireAllKeysRead();  // an unknown tire key is an error, with the nearest key as a hint
-            s.params.validate(p.where());
-          }
-          auto plugin = std::make_unique<TirePlugin>(t, spec.name, spec.bound("wheel"), makeTireModel(t, s.params),
-                                                     SimTK::UnitVec3(s.spin_axis), "road", s.centre_m);
-          if (s.has_slip_centre) plugin->setSlipCentre(s.slip_centre_m);
-          return plugin;
-        },
-        typeInfo(std::string(summary) + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad",
-                 tireSpecFields()));
-  }
+  registerTireKind<BrushTireParams, GimTire>(
+      registry, "gim", "the seed's analytical comprehensive-slip tire (Gim and Nikravesh) on a wheel body");
+  registerTireKind<BrushTireParams, FialaTire>(registry, "fiala", "the Fiala tire as published, on a wheel body");
+  registerTireKind<LinearTireParams, LinearTire>(
+      registry, "linear", "linear tire Fx = C_s kappa, Fy = -C_a alpha (no saturation), on a wheel body");
 }
 
 }  // namespace vdyn

@@ -33,8 +33,7 @@ struct BicycleParams {
   SimTK::Vec3 rear_axle_m{-0.97, 0, -0.30};  ///< rear axle centre in the chassis frame, m
   double front_track_m = 1.2;  ///< distance between the two front tire centres, m
   double rear_track_m = 1.2;
-  std::string tire_plugin = "gim";
-  TireParams tire;
+  TireChoice tire;               ///< the four tires' kind and params
   RoadParams road;
   double gravity_m_per_s2 = 9.81;
 

@@ -30,8 +30,7 @@ struct FourWsParams {
   RigidBodyParams chassis;               ///< body 1 (800 kg; 250/1000/1100 kg m^2)
   DoubleWishboneParams front_right;      ///< bodies 2, 3, 4, 14; LF is its mirror
   DoubleWishboneParams rear_right;       ///< bodies 8, 9, 10, 16; LR is its mirror
-  std::string tire_plugin = "gim";
-  TireParams tire;
+  TireChoice tire;                       ///< one tire kind and params for the four wheels
   RoadParams road;                       ///< flat by default
   double gravity_m_per_s2 = 9.81;        ///< along -z, m/s^2
   /// Data-file key "corner_model": "constrained" (default; each loop closed by

@@ -22,9 +22,8 @@ struct QuarterCarParams {
   /// The App. A right-front corner; the quarter car overrides the knuckle mass
   /// (m3), the spring stiffness K and the damping D with the seed's chapter 4 values.
   DoubleWishboneParams corner;
-  std::string tire_plugin = "gim";
-  /// Tire parameters; radial_stiffness_N_per_m is the seed's design parameter Cz.
-  TireParams tire;
+  /// The tire; its params' radial_stiffness_N_per_m is the seed's design parameter Cz.
+  TireChoice tire;
   RoadParams road;
   /// s': offset along zeta of the upper A-arm's inner pivot point on the arm
   /// (joint 5 of the quarter car, App. A joint 4), m, + up.

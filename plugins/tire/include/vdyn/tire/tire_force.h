@@ -42,7 +42,7 @@ class TireForceImpl : public SimTK::Force::Custom::Implementation {
   /// u_x, u_y (m) as continuous states (z) of `stateSubsystem` (the scene's
   /// force subsystem); call before the system's topology is realized.
   void setStateSubsystem(const SimTK::Subsystem& stateSubsystem) { zSub_ = &stateSubsystem; }
-  bool hasRelaxationStates() const { return model_->params().hasRelaxation(); }
+  bool hasRelaxationStates() const { return model_->hasRelaxation(); }
 
   /// Needs Stage::Velocity (and Time) realized.
   TireContact calcContact(const SimTK::State& state) const;
@@ -101,6 +101,8 @@ class TirePlugin : public ForceElementPlugin {
   const TireForceImpl& getForceElement() const;
   TireContact calcContact(const SimTK::State& s) const { return getForceElement().calcContact(s); }
   const std::string& wheelBody() const { return wheelBody_; }
+  /// The tire law (valid from construction).
+  const TireModel& getModel() const { return *model_; }
 
  protected:
   void DoAddTo(Scene& scene) override;
@@ -115,8 +117,45 @@ class TirePlugin : public ForceElementPlugin {
   const TireForceImpl* impl_ = nullptr;  // owned by the Simbody force subsystem
 };
 
-/// Registers the tire plugins "gim", "fiala" and "linear". Parameters:
-/// {"wheel": "<body name>", "params": {TireParams keys}, "spin_axis": [0, 1, 0],
+/// A vehicle's tire: a tire plugin kind (built in, or from a plugin library)
+/// and the "params" its plugin entry takes (that kind's keys: `vdyn list KIND`).
+/// The vehicle does not read the params itself: the kind's factory does, when
+/// the vehicle adds the tire, and names `where` in its errors.
+struct TireChoice {
+  std::string plugin = "gim";
+  Json params = Json::object();
+  std::string where = "tire";  ///< the data-file location of the tire block, for messages
+
+  /// Reads a data file's tire block {"plugin": KIND, "params": {...}} and, if
+  /// given, a block `overrides` of the same form over it (a derived vehicle
+  /// file's or a scene's "tire"): its plugin replaces the base's, and its
+  /// params merge over the base's while the kind stays the same; another kind
+  /// starts from its own defaults with the override's params (the base's keys
+  /// are the base kind's: gim's mu_max is not a key of linear). Unknown keys of
+  /// either block are an error. (A scene's "overrides" patch the vehicle file
+  /// itself before this: on the file that holds the block, a kind change
+  /// removes the other kind's keys with null, as a JSON merge patch does.)
+  static TireChoice fromParams(const ParamReader& base, const ParamReader* overrides = nullptr);
+  /// The "linear" tire with this brush tire's (gim, fiala) vertical, slip and
+  /// small-slip stiffnesses (LinearTireParams::linearised).
+  TireChoice linearised() const;
+  /// A number of `params`, for design parameters that vary it; the key must be
+  /// given in the data (a kind's default is not known here). Stored as a double.
+  double& updNumber(const std::string& key);
+  /// A number of `params`, or a built-in kind's default for it; throws Error
+  /// naming the key when neither is.
+  double getNumber(const std::string& key) const;
+  /// The plugin entry of this tire on wheel body `wheel`, for the registry;
+  /// `entry` adds the entry's other keys (centre_m, slip_centre_m, ...).
+  PluginSpec makeSpec(const std::string& name, const std::string& wheel, const Json& entry = Json::object()) const;
+};
+
+/// The static radial deflection of `model` under normal load fz_N (Fz = Kz delta), m.
+double calcStaticDeflection(const TireModel& model, double fz_N);
+
+/// Registers the tire plugins "gim", "fiala" (BrushTireParams) and "linear"
+/// (LinearTireParams). Parameters:
+/// {"wheel": "<body name>", "params": {the kind's keys}, "spin_axis": [0, 1, 0],
 ///  "centre_m": [0, 0, 0] (tire centre on the wheel body's spin axis, m),
 ///  "slip_centre_m": [0, 0, 0] (where the slip velocities are taken; default the centre)}.
 void registerTirePlugins(PluginRegistry& registry);
