@@ -36,7 +36,9 @@ struct MagicFormulaInputs {
   double kappa = 0;
   /// Tangent of the slip angle, Vy / |Vx|, dimensionless, Vy the contact-patch
   /// velocity along y_C: > 0 when the patch slides to the LEFT (+y_C); the
-  /// lateral force is then negative (to the right).
+  /// lateral force is then negative (to the right). It is the standard's
+  /// alpha* = tan(alpha) sgn(Vx): dividing by |Vx| keeps the sign right when
+  /// rolling backwards.
   double tan_alpha = 0;
   /// Camber (inclination) angle, rad: > 0 when the top of the wheel leans
   /// toward +y_C (left). Its thrust points the way the wheel leans.
@@ -76,13 +78,14 @@ struct MagicFormulaOutputs {
 
 /// Relaxation lengths at a load and camber (PAC2002 / MF 6.1 PTX, PTY laws).
 struct RelaxationLengths {
-  double longitudinal_m = 0;  ///< sigma_kappa = Fz (PTX1 + PTX2 dfz) exp(-PTX3 dfz) R0 / Fz0' LSGKP, m.
+  double longitudinal_m = 0;  ///< sigma_kappa = Fz (PTX1 + PTX2 dfz) exp(-PTX3 dfz) R0 / FNOMIN LSGKP, m.
   double lateral_m = 0;       ///< sigma_alpha = PTY1 sin(2 atan(Fz / (PTY2 Fz0'))) (1 - PKY3 |gamma|) R0 LFZO LSGAL, m.
 };
 
 /// Evaluates the Magic Formula at `in` (inputs in vdyn's conventions, above;
 /// outputs in the contact frame). Finite for every finite input, including
-/// vx = 0 (standstill): My and the residual torque fade in below VXLOW.
+/// vx = 0 (standstill): below VXLOW the sgn(Vx) of My and of the trail and
+/// residual torque become sin(pi/2 Vx / VXLOW), continuous and 0 at rest.
 MagicFormulaOutputs calcMagicFormula(const MagicFormulaCoefficients& c, const MagicFormulaInputs& in);
 
 /// Loaded radius, m: the wheel-centre height over the road at load fz_N (N,
