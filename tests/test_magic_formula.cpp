@@ -181,6 +181,43 @@ TEST(MagicFormula, CorneringStiffnessPressureFactor) {
   }
 }
 
+TEST(MagicFormula, SlipStiffnessPressureFactor) {
+  const double p0 = 190000, dpi = -0.15;
+  const MagicFormulaCoefficients c =
+      parse(withKeys(readText(kTireFile), {{"PPX1", "-0.4"}, {"PPX2", "0.3"}}, "LONGITUDINAL_COEFFICIENTS"));
+  const double Fz0 = c.FNOMIN * c.LFZO;
+  for (double fz : kLoads_N) {
+    MagicFormulaInputs in = at(fz, 0, 0);
+    in.pressure_Pa = (1 + dpi) * p0;
+    const double dfz = (fz - Fz0) / Fz0;
+    const double closed = fz * (c.PKX1 + c.PKX2 * dfz) * std::exp(c.PKX3 * dfz) *
+                          (1 + c.PPX1 * dpi + c.PPX2 * dpi * dpi) * c.LKX;
+    EXPECT_NEAR(calcMagicFormula(c, in).kxk_N, closed, 1e-12 * closed);
+  }
+}
+
+TEST(MagicFormula, CamberStiffnessMf61) {
+  // FITTYP 61: the camber thrust comes from the camber stiffness Kyg0 = Fz
+  // (PKY6 + PKY7 dfz) LKYC (ISO sign); with the other shifts zero, dFy/dgamma
+  // at zero slip is Kyg0 in ISO terms and -Kyg0 in vdyn's (gamma_ISO = -gamma).
+  const MagicFormulaCoefficients c = parse(withKeys(
+      readText(kTireFile),
+      {{"FITTYP", "61"}, {"PKY6", "-0.9"}, {"PKY7", "0.2"}, {"LGAY", "1.1"}, {"PHY1", "0"}, {"PHY2", "0"},
+       {"PVY1", "0"}, {"PVY2", "0"}, {"PVY3", "-0.3"}, {"PVY4", "0.1"}},
+      "LATERAL_COEFFICIENTS"));
+  ASSERT_EQ(c.FITTYP, 61);
+  const double Fz0 = c.FNOMIN * c.LFZO;
+  for (double fz : kLoads_N) {
+    const double dfz = (fz - Fz0) / Fz0;
+    const double Kyg0 = fz * (c.PKY6 + c.PKY7 * dfz) * c.LKYC;
+    const double h = 1e-6;
+    const double slope =
+        (calcMagicFormula(c, at(fz, 0, 0, h)).fy_N - calcMagicFormula(c, at(fz, 0, 0, -h)).fy_N) / (2 * h);
+    EXPECT_NEAR(slope, -Kyg0, 1e-8 * std::abs(Kyg0)) << fz;
+    EXPECT_GT(slope, 0);  // thrust toward the lean
+  }
+}
+
 TEST(MagicFormula, LateralPeakIsMuYTimesFz) {
   const MagicFormulaCoefficients c = noShifts();
   const double Fz0 = c.FNOMIN * c.LFZO;
@@ -323,6 +360,13 @@ TEST(MagicFormula, TyreSideMirrorsFyMxMz) {
           EXPECT_EQ(calcMagicFormula(left, on_right).fy_N, r.fy_N);
           EXPECT_EQ(calcMagicFormula(left, on_right).mz_N_m, r.mz_N_m);
         }
+  // SYMMETRIC: never mirrored.
+  std::string sym_text = text;
+  sym_text.replace(sym_text.find("'LEFT'"), 6, "'SYMMETRIC'");
+  const MagicFormulaCoefficients sym = parse(sym_text);
+  MagicFormulaInputs on_right = at(3800, 0.02, 0.03, 1 * kDeg);
+  on_right.mounted_side = TireSide::Right;
+  EXPECT_EQ(calcMagicFormula(sym, on_right).fy_N, calcMagicFormula(left, at(3800, 0.02, 0.03, 1 * kDeg)).fy_N);
   // The set is asymmetric (ply steer, conicity: PHY1, PVY1), so the mirror is visible.
   EXPECT_GT(std::abs(calcMagicFormula(right, at(3800, 0, 0)).fy_N - calcMagicFormula(left, at(3800, 0, 0)).fy_N),
             5);
