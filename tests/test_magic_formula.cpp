@@ -148,6 +148,27 @@ TEST(MagicFormulaFile, ReadsThePublishedSet) {
   EXPECT_TRUE(has(f.unused_keys, "ALPMIN"));
 }
 
+TEST(MagicFormulaFile, TablesCommentsQuotesAndAliases) {
+  const std::string good = readText(kTireFile);
+  // A table section, comments after values and in quotes, CRLF line ends.
+  std::string text = good + "[SHAPE]\r\n{radial width}\r\n 1.0    0.0\r\n 0.9    1.0  $ last row\r\n";
+  text.replace(text.find("'LEFT'"), 6, "'RIGHT' ! was 'LEFT' $ side");
+  const TirFile f = parseTirText(text, "t.tir");
+  EXPECT_EQ(f.coefficients.TYRESIDE, TireSide::Right);
+  EXPECT_EQ(f.coefficients.PKY1, -12.536);
+  // A table row that is no number names its line.
+  const std::string bad = good + "[SHAPE]\n{radial width}\n 1.0  x\n";
+  const std::string line = std::to_string(std::count(bad.begin(), bad.end(), '\n'));
+  EXPECT_NE(errorOf([&] { parseTirText(bad, "t.tir"); })
+                .find("'t.tir', line " + line + ": [SHAPE] table entry 'x' is not a number"),
+            std::string::npos)
+      << errorOf([&] { parseTirText(bad, "t.tir"); });
+  // Chrono's pressure names are the standard's INFLPRES / NOMPRES: given twice.
+  EXPECT_NE(errorOf([&] { parseTirText(good + "[TIRE_CONDITIONS]\nIP = 2e5\n", "t.tir"); })
+                .find("IP = 2e5 given twice"),
+            std::string::npos);
+}
+
 TEST(MagicFormula, CorneringStiffnessClosedForm) {
   const MagicFormulaCoefficients c = noShifts();
   const double Fz0 = c.FNOMIN * c.LFZO;

@@ -42,6 +42,7 @@ const std::vector<ModelKey>& modelKeys() {
 const std::map<std::string, std::string>& aliases() {
   static const std::map<std::string, std::string> a = {
       {"LGAY", "LKYC"}, {"LGAZ", "LKZC"}, {"IP", "INFLPRES"}, {"IP_NOM", "NOMPRES"}, {"QPX1", "PPMX1"},
+      {"QPZ1", "PPZ1"}, {"QPZ2", "PPZ2"},
   };
   return a;
 }
@@ -64,8 +65,9 @@ const std::map<std::string, Dim>& unusedKeys() {
                     "DYNAMIC_STIFFNESS", "DYNAMIC_DAMPING", "N_TIRE_STATES", "SWITCH_INTEG", "Q_A1", "Q_A2",
                     "PDXP1", "PDXP2", "PDXP3", "PKYP1", "PDYP1", "PDYP2", "PDYP3", "PDYP4", "PHYP1", "PHYP2",
                     "PHYP3", "PHYP4", "PECP1", "PECP2", "QDTP1", "QCRP1", "QCRP2", "QBRP1", "QDRP1", "QDRP2",
-                    "QDRP3", "HMAX"});
-    add(Dim::Length, {"RIM_RADIUS", "RIM_WIDTH", "BOTTOMING_RADIUS", "BOTTOM_OFFST"});
+                    "QDRP3", "HMAX", "ROAD_DIRECTION", "USER_SUB_ID", "Q_FZ1", "Q_FZ3", "QFZ1", "QFZ2", "QFZ3",
+                    "QPFZ1"});
+    add(Dim::Length, {"RIM_RADIUS", "RIM_WIDTH", "BOTTOMING_RADIUS", "BOTTOM_OFFST", "ROAD_INCREMENT"});
     add(Dim::Force, {"FZMIN", "FZMAX"});
     add(Dim::Angle, {"ALPMIN", "ALPMAX", "CAMMIN", "CAMMAX"});
     add(Dim::Mass, {"MASS", "BELT_MASS", "MBELT"});

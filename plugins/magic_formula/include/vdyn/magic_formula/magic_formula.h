@@ -66,11 +66,11 @@ struct MagicFormulaOutputs {
   double mz_N_m = 0;  ///< Aligning moment about z_C (up), N m: > 0 turns the wheel to the left.
   double mx_N_m = 0;  ///< Overturning moment about x_C, N m.
   double my_N_m = 0;  ///< Rolling resistance moment about y_C, N m: < 0 when rolling forward.
-  // Intermediate quantities of the same evaluation (ISO signs unless noted).
+  // Intermediate quantities of the same evaluation.
   double mu_x = 0;             ///< Peak longitudinal friction coefficient (Dx / Fz).
   double mu_y = 0;             ///< Peak lateral friction coefficient (Dy / Fz).
   double kxk_N = 0;            ///< Longitudinal slip stiffness dFx0/dkappa at kappa = -SHx, N.
-  double kya_N_per_rad = 0;    ///< Cornering stiffness Kya (ISO sign, < 0 for a normal tire), N/rad.
+  double kya_N_per_rad = 0;    ///< Cornering stiffness Kya = dFy/dtan_alpha at alpha = -SHy, N/rad (< 0; same in ISO).
   double gxa = 1;              ///< Combined-slip weight of Fx (1 at zero slip angle).
   double gyk = 1;              ///< Combined-slip weight of Fy (1 at zero slip ratio).
   double trail_m = 0;          ///< Pneumatic trail t, m.
