@@ -15,7 +15,7 @@ include(CMakePackageConfigHelpers)
 # vdyn_sweep_mpi, which exists only when CMake finds MPI.
 set(VDYN_EXPORTED_LIBRARIES
   vdyn_core vdyn_sweep vdyn_sweep_mpi
-  vdyn_tire vdyn_steering vdyn_speed vdyn_forces vdyn_path vdyn_path_control
+  vdyn_magic_formula vdyn_tire vdyn_steering vdyn_speed vdyn_forces vdyn_path vdyn_path_control
   vdyn_linear_ratio vdyn_rear_steer vdyn_steady_state vdyn_steering_ratio vdyn_sensitivity
   vdyn_plugins vdyn_analyses
   vdyn_handling vdyn_vehicles vdyn_handling_vehicles vdyn_standard
