@@ -81,7 +81,12 @@ const FieldTable<BranchSettings>& continuationFields() {
                 "point to the next like the value within branch_max_change_factor; else the solution is another "
                 "branch (refused, the step is bisected)")
         .number("branch_max_change_factor", &S::branch_max_change_factor, "",
-                "bound of (y_new / y_prev) / (value_new / value_prev) and its inverse");
+                "bound of (y_new / y_prev) / (value_new / value_prev) and its inverse")
+        .integer("past_fold_points", &S::past_fold_points, "",
+                 "when the branch ends: pseudo-arclength points continued past its fold (the unstable branch), "
+                 "summary limit.points and table limit.csv")
+        .number("fold_tolerance", &S::fold_tolerance, "(key's)",
+                "arclength bracket to which the fold and Hopf points are located (bounds the error of their value)");
     return t;
   }();
   return t;
@@ -210,6 +215,9 @@ ContinuationAnalysis::ContinuationAnalysis(const ParamReader& r) : Analysis("con
   requirePositive(s_.force_tolerance_N, r.at("force_tolerance_N"));
   if (s_.max_iterations < 1) throw Error(r.at("max_iterations") + ": must be >= 1, got " + std::to_string(s_.max_iterations));
   if (s_.max_bisections < 0) throw Error(r.at("max_bisections") + ": must be >= 0, got " + std::to_string(s_.max_bisections));
+  if (s_.past_fold_points < 0)
+    throw Error(r.at("past_fold_points") + ": must be >= 0, got " + std::to_string(s_.past_fold_points));
+  requirePositive(s_.fold_tolerance, r.at("fold_tolerance"));
   if (!(s_.branch_max_change_factor > 1))
     throw Error(r.at("branch_max_change_factor") + ": must be > 1, got " + formatValue(s_.branch_max_change_factor));
 }
@@ -262,14 +270,30 @@ BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
   values.insert(values.end(), s_.values.begin(), s_.values.end());
   BranchRun run;
   const auto t0 = std::chrono::steady_clock::now();
+  double lastSet = 0;  // the value the natural continuation left the model at
+  const std::function<void(SimTK::State&, double)> setValue = [&](SimTK::State& st, double v) {
+    driver.setAdjustable(st, s_.key, v);
+    for (std::size_t i = 0; i < also.size(); ++i) also[i]->setAdjustable(st, s_.key, v * s_.also_scales[i]);
+  };
   auto pts = followSteadyState(
       solver, start, values,
       [&](SimTK::State& st, double v) {
-        driver.setAdjustable(st, s_.key, v);
-        for (std::size_t i = 0; i < also.size(); ++i) also[i]->setAdjustable(st, s_.key, v * s_.also_scales[i]);
+        lastSet = v;
+        setValue(st, v);
       },
       copt);
   run.solve_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The branch ended (a point failed after a converged one): its limit by
+  // pseudo-arclength continuation from the last converged point.
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    if (pts[i].converged || !pts[i - 1].converged) continue;
+    const auto ta = std::chrono::steady_clock::now();
+    run.limit = followLimit(built, solver, pts[i - 1].result, values[i - 1], values[i], setValue, run);
+    run.solve_wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - ta).count();
+    SimTK::State restore = start;
+    setValue(restore, lastSet);  // leave the model as the natural continuation did
+    break;
+  }
   if (!s_.lead_values.empty() && !pts.front().converged)
     throw Error("continuation: no steady state at the first lead value " + formatValue(s_.lead_values.front()) +
                 " (" + s_.key + " of '" + s_.plugin + "'): " + pts.front().failure);
@@ -283,6 +307,12 @@ BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
       b.status = p.failure.rfind("branch jump refused", 0) == 0 ? "branch_jump_refused"
                  : p.failure.rfind("the branch ended", 0) == 0  ? "beyond_branch_end"
                                                                  : "no_steady_state";
+      // Past the located fold (on the far side from the branch's start): no
+      // steady state on this branch.
+      if (run.has_fold && (p.value - run.fold_value) * (run.fold_value - values.front()) > 0) {
+        b.status = "beyond_fold";
+        b.failure = "beyond the fold at " + formatValue(run.fold_value) + " (" + s_.key + "): " + b.failure;
+      }
     } else if (s_.stability) {
       const auto ts = std::chrono::steady_clock::now();
       b.stability = solver.calcStability(p.result);
@@ -296,6 +326,99 @@ BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
     run.points.push_back(std::move(b));
   }
   return run;
+}
+
+Json ContinuationAnalysis::followLimit(const BuiltScene& built, SteadyStateSolver& solver, const SteadyStateResult& last,
+                                       double vLast, double vFail,
+                                       const std::function<void(SimTK::State&, double)>& setValue,
+                                       BranchRun& run) const {
+  const Scene& sc = built.scene();
+  const SimTK::MobilizedBody& chassis = sc.getBody(s_.chassis);
+  const std::vector<std::string> cols = s_.table_outputs.empty() ? built.outputs : s_.table_outputs;
+  const double gap = std::abs(vFail - vLast);
+  ArclengthOptions o;
+  o.direction = vFail > vLast ? +1 : -1;
+  o.step = 0.25 * gap;  // the grid's last step: a quarter first, grown up to the step
+  o.max_step = gap;
+  o.min_step = s_.fold_tolerance;
+  o.location_tolerance = s_.fold_tolerance;
+  o.max_points = 200;
+  o.stop_after_folds = 1;
+  o.points_after_last_fold = s_.past_fold_points;
+  // The branch is followed no farther than the grid reaches.
+  double lo = std::min(vLast, vFail), hi = std::max(vLast, vFail);
+  for (double v : s_.values) lo = std::min(lo, v), hi = std::max(hi, v);
+  o.lambda_min = lo - gap;
+  o.lambda_max = hi + gap;
+  // Lateral acceleration of the chassis origin in the steady turn: yaw rate x
+  // horizontal speed (m/s^2, + to the left).
+  auto lateral = [&](const SimTK::State& st) {
+    SimTK::State s = st;
+    sc.getSystem().realize(s, SimTK::Stage::Velocity);
+    const SimTK::Vec3 v = chassis.getBodyOriginVelocity(s);
+    return chassis.getBodyAngularVelocity(s)[2] * std::hypot(v[0], v[1]);
+  };
+  auto eigJson = [](const std::vector<std::complex<double>>& ev) {
+    Json e = Json::array();
+    for (const auto& z : ev) e.push_back({z.real(), z.imag()});
+    return e;
+  };
+  // The point's steady state, outputs and lateral acceleration (with the
+  // model at the point's value: a held steering angle is a model parameter).
+  auto describe = [&](const ArclengthPoint& p) {
+    const SteadyStateResult r = solver.makeDrivenResult(p.x, p.lambda);
+    Json outs = Json::object();
+    for (const auto& c : cols) outs[c] = sc.evalOutput(c, r.state);
+    Json j = {{"value", p.lambda}, {"arclength", p.s}, {"lateral_acceleration_m_s2", lateral(r.state)},
+              {"outputs", outs}};
+    if (p.have_eigenvalues) {
+      j["stable"] = p.stable;
+      j["least_damped_eigenvalue"] = p.eigenvalues.empty() ? Json::array({0, 0})
+                                                           : Json::array({p.eigenvalues.front().real(),
+                                                                          p.eigenvalues.front().imag()});
+    }
+    return std::make_pair(j, r);
+  };
+  Json limit = {{"from_value", vLast}, {"failed_value", vFail}, {"fold", nullptr}, {"hopf", Json::array()}};
+  ArclengthResult ar;
+  try {
+    ar = continueSteadyState(solver, last, vLast, setValue, gap, s_.stability, o);
+  } catch (const Error& e) {
+    limit["failure"] = e.what();
+    return limit;
+  }
+  Json points = Json::array();
+  for (const auto& p : ar.points) {
+    auto [j, r] = describe(p);
+    j["past_fold"] = !ar.special.empty() && ar.special.front().kind == "fold" ? p.s > ar.special.front().point.s : false;
+    std::vector<double> row = {p.lambda, p.s, p.have_eigenvalues ? double(p.stable) : NAN,
+                               p.have_eigenvalues && !p.eigenvalues.empty() ? p.eigenvalues.front().real() : NAN,
+                               p.have_eigenvalues && !p.eigenvalues.empty() ? p.eigenvalues.front().imag() : NAN,
+                               j.at("lateral_acceleration_m_s2").get<double>()};
+    for (const auto& c : cols) row.push_back(j.at("outputs").at(c).get<double>());
+    run.limit_rows.push_back(row);
+    points.push_back(j);
+  }
+  for (const auto& sp : ar.special) {
+    auto [j, r] = describe(sp.point);
+    j["located"] = sp.located;
+    j["bracket"] = sp.bracket_length;
+    j["location_iterations"] = sp.location_iterations;
+    j["eigenvalues"] = eigJson(sp.point.eigenvalues);
+    if (sp.kind == "fold" && limit.at("fold").is_null()) {
+      limit["fold"] = j;
+      run.has_fold = true;
+      run.fold_value = sp.point.lambda;
+    } else if (sp.kind == "hopf") {
+      limit["hopf"].push_back(j);
+    }
+  }
+  limit.update({{"points", points},
+                {"steps", ar.steps},
+                {"rejected_steps", ar.rejected_steps},
+                {"corrector_iterations", ar.corrector_iterations},
+                {"stop_reason", ar.stop_reason}});
+  return limit;
 }
 
 Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& run) const {
@@ -312,11 +435,18 @@ Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& r
       ++none;
       refused += p.status == "branch_jump_refused";
       pj["failure"] = p.failure;
-      if (p.status != "beyond_branch_end")
+      if (p.status != "beyond_branch_end" && lastStable != -2)
         labels.push_back({{"from_value", lastValue},
                           {"to_value", p.value},
-                          {"label", p.status == "branch_jump_refused" ? "branch_jump_refused" : "branch_end"},
+                          {"label", p.status == "branch_jump_refused" ? "branch_jump_refused"
+                                    : p.status == "beyond_fold"       ? "fold"
+                                                                      : "branch_end"},
                           {"reason", p.failure}});
+      if (p.status == "beyond_fold") {
+        lastStable = -2;  // one label for the fold
+        points.push_back(pj);
+        continue;
+      }
       lastStable = -1;
       points.push_back(pj);
       continue;
@@ -362,6 +492,8 @@ Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& r
               {"largest_stable_value", largestStable},
               {"stability_wall_time_s", run.stability_wall_time_s}});
   if (!last.is_null()) j["last_converged_point"] = last;
+  j["limit"] = run.limit;
+  j["limit_value"] = run.has_fold ? Json(run.fold_value) : Json(nullptr);
   return j;
 }
 
@@ -387,6 +519,14 @@ AnalysisResult ContinuationAnalysis::DoRun(const AnalysisContext& ctx) const {
   AnalysisResult res;
   res.summary = summarize(ctx.built, run);
   res.tables.push_back({"continuation", t});
+  if (!run.limit_rows.empty()) {
+    Table l;
+    l.columns = {s_.key, "arclength", "stable", "least_damped_real_per_s", "least_damped_imag_per_s",
+                 "lateral_acceleration_m_s2"};
+    l.columns.insert(l.columns.end(), cols.begin(), cols.end());
+    l.rows = run.limit_rows;
+    res.tables.push_back({"limit", l});
+  }
   return res;
 }
 
