@@ -227,7 +227,9 @@ class Continuer {
         res.stop_reason = "lambda_range";
         break;
       }
-      if (opt_.stop_after_folds > 0 && folds >= opt_.stop_after_folds && after++ >= opt_.points_after_last_fold) {
+      // The point that revealed the fold is the first past it.
+      if (opt_.stop_after_folds > 0 && folds >= opt_.stop_after_folds &&
+          ++after >= std::max(1, opt_.points_after_last_fold)) {
         res.stop_reason = "folds";
         break;
       }

@@ -67,7 +67,8 @@ struct ArclengthOptions {
   /// Stop after this many folds were passed (0: never); the points beyond the
   /// last fold up to the stop are kept.
   int stop_after_folds = 0;
-  /// Points to continue past the stop_after_folds-th fold before stopping.
+  /// Points past the stop_after_folds-th fold before stopping (at least 1:
+  /// the point whose test function revealed it).
   int points_after_last_fold = 0;
 };
 
