@@ -14,6 +14,7 @@
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/arclength.h"
 #include "vdyn/steady_state/steady_state.h"
+#include "vdyn/steady_state/straight_start.h"
 #include "vdyn/steering/steering.h"
 #include "vdyn/vehicles/bicycle.h"
 
@@ -226,4 +227,43 @@ TEST(Arclength, BicycleFoldInSteeringAgreesWithTheLastConvergedPointAndPassesIt)
   }
   EXPECT_GE(before, 3);
   EXPECT_GE(past, 3);
+}
+
+// The steady state on the branch from straight running (solveFromStraightRunning:
+// the command time continued from 0): the GIM bicycle at 20 m/s with a smooth
+// step of the front angle. At 1 deg it is the direct solve's state (to the
+// solver's precision); at 3 deg, past the fold in steering (1.851124 deg,
+// found above by continuation in a held angle), it is the named error with the
+// fold's front angle, found here by a homotopy in time instead.
+TEST(Arclength, SteadyStateFromStraightRunningStopsAtTheFold) {
+  const double U = 20.0;
+  auto solveWith = [&](double finalDeg, bool straight) {
+    BicycleParams p = BicycleParams::fromFile("bicycle.json");
+    p.tire_plugin = "gim";
+    Bicycle bike(p);
+    bike.addFrontSteering("front_steer", std::make_shared<SmoothStepCommand>(0.0, finalDeg * kDeg, 0.5, 1.0));
+    bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U));
+    const Scene& sc = bike.getScene();
+    SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"front_axle", "rear_axle"}, 1.5));
+    const SimTK::State start = bike.makeInitialState(U);
+    StraightStartReport rep;
+    const SteadyStateResult r =
+        straight ? solveFromStraightRunning(
+                       solver, sc, start,
+                       [&sc](const SimTK::State& s) { return sc.evalOutput("front_steer.command_rad", s); }, &rep)
+                 : solver.solve(start);
+    if (straight) std::printf("  %g deg: %d homotopy steps, %d rejected\n", finalDeg, rep.arclength_steps, rep.rejected_steps);
+    return sc.evalOutput("chassis.yaw_rate_rad_s", r.state);
+  };
+  const double rs = solveWith(1.0, true), rd = solveWith(1.0, false);
+  std::printf("1 deg: yaw rate from straight running %.12f, direct %.12f (difference %.1e)\n", rs, rd, rs - rd);
+  EXPECT_NEAR(rs, rd, 1e-9 * rd);
+  EXPECT_GT(rs, 0);
+  const std::string msg = errorOf([&] { solveWith(3.0, true); });
+  std::printf("3 deg: %s\n", msg.c_str());
+  const std::string head = "no steady state on the branch from straight running: fold at front steer ";
+  ASSERT_EQ(msg.rfind(head, 0), 0u) << msg;
+  const double foldDeg = std::stod(msg.substr(head.size()));
+  EXPECT_NEAR(foldDeg, 1.851124, 1e-5);
+  EXPECT_NE(msg.find("lateral acceleration 6.74"), std::string::npos) << msg;
 }

@@ -11,6 +11,7 @@
 #include "vdyn/analyses/branch_analyses.h"
 #include "vdyn/core/equilibrium.h"
 #include "vdyn/steady_state/steady_state.h"
+#include "vdyn/steady_state/straight_start.h"
 
 namespace vdyn {
 
@@ -25,6 +26,7 @@ struct SteadySettings {
   int max_iterations = 60;
   bool stability = false;
   double stability_tolerance_per_s = 1e-6;
+  std::string start = "straight";  ///< "straight": on the branch from straight running; "given": Newton from the scene's state
 };
 
 template <class T>
@@ -36,10 +38,16 @@ FieldTable<T>& addSteadyFields(FieldTable<T>& t) {
       .integer("max_iterations", &T::max_iterations, "", "Newton iterations before a failure");
 }
 
+const char* const kStartDoc =
+    "straight (default): the state on the branch from straight running (the command time continued by "
+    "pseudo-arclength from 0, when the commands have not moved, to time_s; a fold on the way is an error); "
+    "given: Newton directly from the scene's initial state";
+
 const FieldTable<SteadySettings>& steadyFields() {
   static const auto t = [] {
     FieldTable<SteadySettings> t;
     addSteadyFields(t)
+        .string("start", &SteadySettings::start, kStartDoc)
         .boolean("stability", &SteadySettings::stability, "also linearise and report the eigenvalues")
         .number("stability_tolerance_per_s", &SteadySettings::stability_tolerance_per_s, "1/s",
                 "stable when every real part < -tolerance");
@@ -51,8 +59,10 @@ const FieldTable<SteadySettings>& steadyFields() {
 const FieldTable<SteadySettings>& stabilityFields() {
   static const auto t = [] {
     FieldTable<SteadySettings> t;
-    addSteadyFields(t).number("stability_tolerance_per_s", &SteadySettings::stability_tolerance_per_s, "1/s",
-                              "stable when every real part < -tolerance");
+    addSteadyFields(t)
+        .string("start", &SteadySettings::start, kStartDoc)
+        .number("stability_tolerance_per_s", &SteadySettings::stability_tolerance_per_s, "1/s",
+                "stable when every real part < -tolerance");
     return t;
   }();
   return t;
@@ -117,11 +127,21 @@ Json stabilityJson(const StabilityResult& st, double wall) {
           {"stability_wall_time_s", wall}};
 }
 
+/// The front steering angle of a scene's state (rad), for the straight-start
+/// fold message: the output "front_steer.command_rad" if the scene has it.
+std::function<double(const SimTK::State&)> frontSteerOf(const Scene& sc) {
+  const auto names = sc.getOutputNames();
+  if (std::find(names.begin(), names.end(), "front_steer.command_rad") == names.end()) return {};
+  return [&sc](const SimTK::State& s) { return sc.evalOutput("front_steer.command_rad", s); };
+}
+
 class SteadyStateAnalysis : public Analysis {
  public:
   SteadyStateAnalysis(const std::string& type, const ParamReader& r) : Analysis(type) {
     (type == "stability" ? stabilityFields() : steadyFields()).read(r, s_);
     if (type == "stability") s_.stability = true;
+    if (s_.start != "straight" && s_.start != "given")
+      throw Error(r.at("start") + ": must be \"straight\" or \"given\", got \"" + s_.start + "\"");
     requirePositive(s_.force_tolerance_N, r.at("force_tolerance_N"));
     if (s_.max_iterations < 1) throw Error(r.at("max_iterations") + ": must be >= 1, got " + std::to_string(s_.max_iterations));
   }
@@ -134,7 +154,9 @@ class SteadyStateAnalysis : public Analysis {
     opt.force_tolerance = s_.force_tolerance_N;
     opt.max_iterations = s_.max_iterations;
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, s_.chassis, wheelsOf(s_, ctx.built), s_.time_s), opt);
-    const SteadyStateResult ss = solver.solve(initial);
+    StraightStartReport rep;
+    const SteadyStateResult ss =
+        s_.start == "given" ? solver.solve(initial) : solveFromStraightRunning(solver, sc, initial, frontSteerOf(sc), &rep);
     AnalysisResult res;
     res.summary = {{"steady", outputsAt(sc, ss.state)},
                    {"newton_iterations", ss.iterations},
@@ -144,6 +166,7 @@ class SteadyStateAnalysis : public Analysis {
                    {"force_residual_N", ss.force_residual},
                    {"wall_time_s", ss.wall_time_s},
                    {"vehicle", ctx.built.vehicle->describe(initial)}};
+    if (s_.start == "straight") res.summary["homotopy_steps"] = rep.arclength_steps;
     if (s_.stability) {
       const auto t0 = std::chrono::steady_clock::now();
       const StabilityResult st = solver.calcStability(ss, s_.stability_tolerance_per_s);
