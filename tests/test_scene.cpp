@@ -618,3 +618,16 @@ TEST(SceneAnalyses, ContinuationLimitIsTheFoldAndPassesIt) {
   }
   EXPECT_EQ(past, 3);  // past_fold_points
 }
+
+TEST(SceneAnalyses, SteadyStateStartIsStraightOrGiven) {
+  const SceneDescription ch3 = SceneDescription::fromFile("scenes/ch3_steady_state.json", standardRegistry());
+  EXPECT_TRUE(contains(errorOf([&] { ch3.withOverride("analysis.start", "foo").build(); }),
+                       "analysis.start: must be \"straight\" or \"given\", got \"foo\""));
+  // Both starts land on the same steady state here (to the solver's precision).
+  const Json straight = runScene(ch3), given = runScene(ch3.withOverride("analysis.start", "given"));
+  const double rs = straight["steady"]["chassis.yaw_rate_rad_s"].get<double>();
+  const double rg = given["steady"]["chassis.yaw_rate_rad_s"].get<double>();
+  EXPECT_NEAR(rs, rg, 1e-10 * rg);
+  EXPECT_GT(straight["homotopy_steps"].get<int>(), 0);
+  EXPECT_FALSE(given.contains("homotopy_steps"));
+}
