@@ -1,6 +1,7 @@
 // Handling tests (plugins/handling): ISO 4138 constant radius against the
 // linear bicycle's closed form and a long transient; ISO 7401 frequency
 // response against sine-steer simulations.
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 
@@ -87,6 +88,58 @@ TEST(Iso4138, LongTransientEndsOnTheConstantRadiusSteadyState) {
     // Path radius of the transient: U / r.
     EXPECT_NEAR(speed / rT, 40.0, 40.0 * 1e-5);
   }
+}
+
+// The limit of the constant-radius test is the fold of the steady states in
+// speed (pseudo-arclength continuation): within a speed step above the last
+// point the 1 m/s sweep converged (the old limit), located to its tolerance;
+// natural continuation 0.01 m/s below it converges and 0.01 m/s above fails;
+// the branch past it (the speed falls again, and with it a_y = U^2 / R) is
+// unstable with the steering held (an eigenvalue with positive real part).
+// (The front angle is an unknown of this problem: the fold is not one of the
+// fixed-control dynamics, so no eigenvalue need vanish there.)
+TEST(Iso4138, LimitIsTheFoldInSpeedAndTheBranchPastItIsUnstable) {
+  auto run = [](double start, double step, double max, bool stability) {
+    auto b = bike("gim");
+    ConstantRadiusSettings set;
+    set.radius_m = 40;
+    set.speed_start_m_s = start;
+    set.speed_step_m_s = step;
+    set.speed_max_m_s = max;
+    set.limit_tolerance_m_s = 1e-6;
+    set.stability = stability;
+    return runConstantRadius(b->vehicle, set);
+  };
+  const ConstantRadiusResult r = run(10, 1, 40, true);
+  ASSERT_TRUE(r.limit_found) << r.limit_reason;
+  const double last = r.points.back().speed_m_s;
+  double nearZero = 1e300;
+  for (const auto& e : r.limit_eigenvalues) nearZero = std::min(nearZero, std::abs(e));
+  ASSERT_FALSE(r.limit_eigenvalues.empty());
+  std::printf("R 40 m: fold at %.7f m/s, a_y %.5f m/s^2, front %.5f deg (bracket %.1e m/s, %d steps, %d rejected); "
+              "last converged of the 1 m/s sweep %.1f m/s; smallest |eigenvalue| %.2e /s; %zu points past it\n",
+              r.limit_speed_m_s, r.limit_lateral_accel_m_s2, r.limit_front_rad / kDeg, r.limit_bracket_m_s,
+              r.limit_steps, r.limit_rejected_steps, last, nearZero, r.past_limit_points.size());
+  EXPECT_GE(r.limit_speed_m_s, last);
+  EXPECT_LT(r.limit_speed_m_s, last + 1);
+  EXPECT_LE(r.limit_bracket_m_s, 1e-6);
+  ASSERT_GE(r.past_limit_points.size(), 3u);
+  for (const auto& q : r.past_limit_points) {
+    EXPECT_LT(q.speed_m_s, r.limit_speed_m_s);
+    EXPECT_LT(q.lateral_accel_m_s2, r.limit_lateral_accel_m_s2);
+    EXPECT_GT(q.least_damped.real(), 0) << q.speed_m_s;
+    EXPECT_NEAR(q.path_radius_m, 40.0, 1e-8);
+  }
+  // Independent: natural continuation to 0.01 m/s below the fold converges,
+  // to 0.01 m/s above it does not (and locates the same fold).
+  const double below = r.limit_speed_m_s - 0.01, above = r.limit_speed_m_s + 0.01;
+  const ConstantRadiusResult rb = run(last, below - last, below, false);
+  EXPECT_EQ(rb.points.size(), 2u);
+  EXPECT_FALSE(rb.limit_found);
+  const ConstantRadiusResult ra = run(last, above - last, above, false);
+  EXPECT_EQ(ra.points.size(), 1u);
+  EXPECT_TRUE(ra.limit_found);
+  EXPECT_NEAR(ra.limit_speed_m_s, r.limit_speed_m_s, 2e-6);
 }
 
 TEST(Iso7401, FrequencyResponseMatchesSineSteerSimulations) {

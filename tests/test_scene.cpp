@@ -568,3 +568,66 @@ TEST(SceneAnalyses, ContinuationLeadValuesAreSolvedButNotReported) {
   EXPECT_TRUE(contains(errorOf([&] { runScene(sweep.withOverride("analysis.branch_output", "chassis.yaw_rat")); }),
                        "chassis.yaw_rat"));
 }
+
+// The continuation's limit (issue 22): at 20 m/s (scenes/steady_sweep.json,
+// rear at 0.25 of the front) the branch in the front angle ends; its fold,
+// located by pseudo-arclength continuation, lies within the grid step above
+// the last converged point (the old limit) and below the first failed value;
+// the points continued past it are unstable (an eigenvalue with positive real
+// part), and the grid points beyond it are "beyond_fold".
+TEST(SceneAnalyses, ContinuationLimitIsTheFoldAndPassesIt) {
+  const SceneDescription sweep = SceneDescription::fromFile(
+      "scenes/steady_sweep.json", standardRegistry(),
+      {{"vehicle.initial_speed_m_s", 20.0}, {"plugins.speed_hold.speed_m_s", 20.0}});
+  const Json j = runScene(sweep);
+  const double last = j["last_converged_point"]["value"].get<double>();
+  double failed = 0;
+  for (const auto& p : j["points"])
+    if (!p["converged"].get<bool>()) {
+      failed = p["value"].get<double>();
+      EXPECT_EQ(p["status"], "beyond_fold");
+      break;
+    }
+  ASSERT_GT(failed, last);
+  const Json& fold = j["limit"]["fold"];
+  ASSERT_FALSE(fold.is_null()) << j["limit"].dump();
+  const double v = fold["value"].get<double>();
+  std::printf("20 m/s: fold at %.6f deg (a_y %.4f m/s^2, bracket %.1e rad), last converged %.2f deg, failed %.2f deg; "
+              "%d steps, %d rejected\n",
+              v * 180 / SimTK::Pi, fold["lateral_acceleration_m_s2"].get<double>(), fold["bracket"].get<double>(),
+              last * 180 / SimTK::Pi, failed * 180 / SimTK::Pi, j["limit"]["steps"].get<int>(),
+              j["limit"]["rejected_steps"].get<int>());
+  EXPECT_GT(v, last);
+  EXPECT_LT(v, failed);
+  EXPECT_EQ(j["limit_value"].get<double>(), v);
+  EXPECT_TRUE(fold["located"].get<bool>());
+  EXPECT_LE(fold["bracket"].get<double>(), 1e-7);  // fold_tolerance
+  // At the fold of the fixed-steer dynamics a real eigenvalue crosses zero.
+  EXPECT_LE(std::abs(fold["eigenvalues"][0][0].get<double>()), 1e-3);
+  int past = 0;
+  for (const auto& p : j["limit"]["points"]) {
+    if (!p["past_fold"].get<bool>()) {
+      EXPECT_TRUE(p["stable"].get<bool>());
+      continue;
+    }
+    ++past;
+    EXPECT_FALSE(p["stable"].get<bool>());
+    EXPECT_GT(p["least_damped_eigenvalue"][0].get<double>(), 0);
+    EXPECT_LT(p["value"].get<double>(), v);
+    EXPECT_GT(p["lateral_acceleration_m_s2"].get<double>(), fold["lateral_acceleration_m_s2"].get<double>());
+  }
+  EXPECT_EQ(past, 3);  // past_fold_points
+}
+
+TEST(SceneAnalyses, SteadyStateStartIsStraightOrGiven) {
+  const SceneDescription ch3 = SceneDescription::fromFile("scenes/ch3_steady_state.json", standardRegistry());
+  EXPECT_TRUE(contains(errorOf([&] { ch3.withOverride("analysis.start", "foo").build(); }),
+                       "analysis.start: must be \"straight\" or \"given\", got \"foo\""));
+  // Both starts land on the same steady state here (to the solver's precision).
+  const Json straight = runScene(ch3), given = runScene(ch3.withOverride("analysis.start", "given"));
+  const double rs = straight["steady"]["chassis.yaw_rate_rad_s"].get<double>();
+  const double rg = given["steady"]["chassis.yaw_rate_rad_s"].get<double>();
+  EXPECT_NEAR(rs, rg, 1e-10 * rg);
+  EXPECT_GT(straight["homotopy_steps"].get<int>(), 0);
+  EXPECT_FALSE(given.contains("homotopy_steps"));
+}

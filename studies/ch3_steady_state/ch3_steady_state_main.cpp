@@ -11,6 +11,7 @@
 #include "study.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/steady_state/steady_state.h"
+#include "vdyn/steady_state/straight_start.h"
 
 using namespace vdyn;
 
@@ -60,7 +61,10 @@ int main(int argc, char** argv) {
     // commands are evaluated after they settled (Ch3Case::settledTime).
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"},
                                                           ch3.settledTime()));
-    const SteadyStateResult ss = solver.solve(initial);
+    // On the branch from straight running (the steady_state analysis's default
+    // start): the command time continued from 0 to the settled time.
+    const SteadyStateResult ss = solveFromStraightRunning(
+        solver, sc, initial, [&sc](const SimTK::State& st) { return sc.evalOutput("front_steer.command_rad", st); });
     const auto ts = std::chrono::steady_clock::now();
     const StabilityResult stab = solver.calcStability(ss);
     const double stabilityTime = std::chrono::duration<double>(std::chrono::steady_clock::now() - ts).count();

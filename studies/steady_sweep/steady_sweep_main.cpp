@@ -99,7 +99,8 @@ int main(int argc, char** argv) {
     Json byRatio = Json::array(), labels = Json::array();
     double kJump = 0;
     std::printf("steady_sweep: %zu speeds x %zu front angles x rear ratios {0, %g}\n", speeds.size(), fronts.size(), ratio);
-    std::printf("  %6s %6s  %s\n", "ratio", "U m/s", "largest front angle with a stable steady state (deg); median iterations");
+    std::printf("  %6s %6s  %s\n", "ratio", "U m/s",
+                "largest front angle with a stable steady state (deg); median iterations; fold (deg, a_y m/s^2)");
     for (double kr : {0.0, ratio}) {
       Json rows = Json::array();
       for (double U : speeds) {
@@ -154,12 +155,23 @@ int main(int argc, char** argv) {
         refused += branch.at("branch_jumps_refused").get<int>();
         const double largestStable = toDeg(branch.at("largest_stable_value").get<double>());
         std::sort(its.begin(), its.end());
-        std::printf("  %6g %6g  %5.2f; %d\n", kr, U, largestStable, its.empty() ? -1 : its[its.size() / 2]);
+        // The branch's limit: the fold located by pseudo-arclength continuation.
+        const Json& fold = branch.at("limit").is_null() ? Json() : branch.at("limit").at("fold");
+        if (fold.is_null())
+          std::printf("  %6g %6g  %5.2f; %d; no fold in the grid\n", kr, U, largestStable,
+                      its.empty() ? -1 : its[its.size() / 2]);
+        else
+          std::printf("  %6g %6g  %5.2f; %d; fold %.4f deg, %.3f m/s^2\n", kr, U, largestStable,
+                      its.empty() ? -1 : its[its.size() / 2], fold.at("value").get<double>() / deg,
+                      fold.at("lateral_acceleration_m_s2").get<double>());
         std::fflush(stdout);
         // The branch's numbers as `vdyn run` reports them (the continuation
         // analysis's summary without the per-point list and the wall times).
         for (const char* k : {"points", "branch_labels", "solve_wall_time_s", "stability_wall_time_s"}) branch.erase(k);
-        rows.push_back({{"speed_m_s", U}, {"largest_stable_front_deg", largestStable}, {"continuation", branch}});
+        rows.push_back({{"speed_m_s", U},
+                        {"largest_stable_front_deg", largestStable},
+                        {"fold_front_deg", fold.is_null() ? Json(nullptr) : Json(fold.at("value").get<double>() / deg)},
+                        {"continuation", branch}});
       }
       byRatio.push_back({{"rear_ratio", kr}, {"speeds", rows}});
     }

@@ -11,6 +11,7 @@
 #include "vdyn/analyses/branch_analyses.h"
 #include "vdyn/core/equilibrium.h"
 #include "vdyn/steady_state/steady_state.h"
+#include "vdyn/steady_state/straight_start.h"
 
 namespace vdyn {
 
@@ -25,6 +26,7 @@ struct SteadySettings {
   int max_iterations = 60;
   bool stability = false;
   double stability_tolerance_per_s = 1e-6;
+  std::string start = "straight";  ///< "straight": on the branch from straight running; "given": Newton from the scene's state
 };
 
 template <class T>
@@ -36,10 +38,16 @@ FieldTable<T>& addSteadyFields(FieldTable<T>& t) {
       .integer("max_iterations", &T::max_iterations, "", "Newton iterations before a failure");
 }
 
+const char* const kStartDoc =
+    "straight (default): the state on the branch from straight running (the command time continued by "
+    "pseudo-arclength from 0, when the commands have not moved, to time_s; a fold on the way is an error); "
+    "given: Newton directly from the scene's initial state";
+
 const FieldTable<SteadySettings>& steadyFields() {
   static const auto t = [] {
     FieldTable<SteadySettings> t;
     addSteadyFields(t)
+        .string("start", &SteadySettings::start, kStartDoc)
         .boolean("stability", &SteadySettings::stability, "also linearise and report the eigenvalues")
         .number("stability_tolerance_per_s", &SteadySettings::stability_tolerance_per_s, "1/s",
                 "stable when every real part < -tolerance");
@@ -51,8 +59,10 @@ const FieldTable<SteadySettings>& steadyFields() {
 const FieldTable<SteadySettings>& stabilityFields() {
   static const auto t = [] {
     FieldTable<SteadySettings> t;
-    addSteadyFields(t).number("stability_tolerance_per_s", &SteadySettings::stability_tolerance_per_s, "1/s",
-                              "stable when every real part < -tolerance");
+    addSteadyFields(t)
+        .string("start", &SteadySettings::start, kStartDoc)
+        .number("stability_tolerance_per_s", &SteadySettings::stability_tolerance_per_s, "1/s",
+                "stable when every real part < -tolerance");
     return t;
   }();
   return t;
@@ -81,7 +91,12 @@ const FieldTable<BranchSettings>& continuationFields() {
                 "point to the next like the value within branch_max_change_factor; else the solution is another "
                 "branch (refused, the step is bisected)")
         .number("branch_max_change_factor", &S::branch_max_change_factor, "",
-                "bound of (y_new / y_prev) / (value_new / value_prev) and its inverse");
+                "bound of (y_new / y_prev) / (value_new / value_prev) and its inverse")
+        .integer("past_fold_points", &S::past_fold_points, "",
+                 "when the branch ends: pseudo-arclength points continued past its fold (the unstable branch), "
+                 "summary limit.points and table limit.csv")
+        .number("fold_tolerance", &S::fold_tolerance, "(key's)",
+                "arclength bracket to which the fold and Hopf points are located (bounds the error of their value)");
     return t;
   }();
   return t;
@@ -112,11 +127,21 @@ Json stabilityJson(const StabilityResult& st, double wall) {
           {"stability_wall_time_s", wall}};
 }
 
+/// The front steering angle of a scene's state (rad), for the straight-start
+/// fold message: the output "front_steer.command_rad" if the scene has it.
+std::function<double(const SimTK::State&)> frontSteerOf(const Scene& sc) {
+  const auto names = sc.getOutputNames();
+  if (std::find(names.begin(), names.end(), "front_steer.command_rad") == names.end()) return {};
+  return [&sc](const SimTK::State& s) { return sc.evalOutput("front_steer.command_rad", s); };
+}
+
 class SteadyStateAnalysis : public Analysis {
  public:
   SteadyStateAnalysis(const std::string& type, const ParamReader& r) : Analysis(type) {
     (type == "stability" ? stabilityFields() : steadyFields()).read(r, s_);
     if (type == "stability") s_.stability = true;
+    if (s_.start != "straight" && s_.start != "given")
+      throw Error(r.at("start") + ": must be \"straight\" or \"given\", got \"" + s_.start + "\"");
     requirePositive(s_.force_tolerance_N, r.at("force_tolerance_N"));
     if (s_.max_iterations < 1) throw Error(r.at("max_iterations") + ": must be >= 1, got " + std::to_string(s_.max_iterations));
   }
@@ -129,7 +154,9 @@ class SteadyStateAnalysis : public Analysis {
     opt.force_tolerance = s_.force_tolerance_N;
     opt.max_iterations = s_.max_iterations;
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, s_.chassis, wheelsOf(s_, ctx.built), s_.time_s), opt);
-    const SteadyStateResult ss = solver.solve(initial);
+    StraightStartReport rep;
+    const SteadyStateResult ss =
+        s_.start == "given" ? solver.solve(initial) : solveFromStraightRunning(solver, sc, initial, frontSteerOf(sc), &rep);
     AnalysisResult res;
     res.summary = {{"steady", outputsAt(sc, ss.state)},
                    {"newton_iterations", ss.iterations},
@@ -139,6 +166,7 @@ class SteadyStateAnalysis : public Analysis {
                    {"force_residual_N", ss.force_residual},
                    {"wall_time_s", ss.wall_time_s},
                    {"vehicle", ctx.built.vehicle->describe(initial)}};
+    if (s_.start == "straight") res.summary["homotopy_steps"] = rep.arclength_steps;
     if (s_.stability) {
       const auto t0 = std::chrono::steady_clock::now();
       const StabilityResult st = solver.calcStability(ss, s_.stability_tolerance_per_s);
@@ -210,6 +238,9 @@ ContinuationAnalysis::ContinuationAnalysis(const ParamReader& r) : Analysis("con
   requirePositive(s_.force_tolerance_N, r.at("force_tolerance_N"));
   if (s_.max_iterations < 1) throw Error(r.at("max_iterations") + ": must be >= 1, got " + std::to_string(s_.max_iterations));
   if (s_.max_bisections < 0) throw Error(r.at("max_bisections") + ": must be >= 0, got " + std::to_string(s_.max_bisections));
+  if (s_.past_fold_points < 0)
+    throw Error(r.at("past_fold_points") + ": must be >= 0, got " + std::to_string(s_.past_fold_points));
+  requirePositive(s_.fold_tolerance, r.at("fold_tolerance"));
   if (!(s_.branch_max_change_factor > 1))
     throw Error(r.at("branch_max_change_factor") + ": must be > 1, got " + formatValue(s_.branch_max_change_factor));
 }
@@ -262,14 +293,30 @@ BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
   values.insert(values.end(), s_.values.begin(), s_.values.end());
   BranchRun run;
   const auto t0 = std::chrono::steady_clock::now();
+  double lastSet = 0;  // the value the natural continuation left the model at
+  const std::function<void(SimTK::State&, double)> setValue = [&](SimTK::State& st, double v) {
+    driver.setAdjustable(st, s_.key, v);
+    for (std::size_t i = 0; i < also.size(); ++i) also[i]->setAdjustable(st, s_.key, v * s_.also_scales[i]);
+  };
   auto pts = followSteadyState(
       solver, start, values,
       [&](SimTK::State& st, double v) {
-        driver.setAdjustable(st, s_.key, v);
-        for (std::size_t i = 0; i < also.size(); ++i) also[i]->setAdjustable(st, s_.key, v * s_.also_scales[i]);
+        lastSet = v;
+        setValue(st, v);
       },
       copt);
   run.solve_wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // The branch ended (a point failed after a converged one): its limit by
+  // pseudo-arclength continuation from the last converged point.
+  for (std::size_t i = 1; i < pts.size(); ++i) {
+    if (pts[i].converged || !pts[i - 1].converged) continue;
+    const auto ta = std::chrono::steady_clock::now();
+    run.limit = followLimit(built, solver, pts[i - 1].result, values[i - 1], values[i], setValue, run);
+    run.solve_wall_time_s += std::chrono::duration<double>(std::chrono::steady_clock::now() - ta).count();
+    SimTK::State restore = start;
+    setValue(restore, lastSet);  // leave the model as the natural continuation did
+    break;
+  }
   if (!s_.lead_values.empty() && !pts.front().converged)
     throw Error("continuation: no steady state at the first lead value " + formatValue(s_.lead_values.front()) +
                 " (" + s_.key + " of '" + s_.plugin + "'): " + pts.front().failure);
@@ -283,6 +330,12 @@ BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
       b.status = p.failure.rfind("branch jump refused", 0) == 0 ? "branch_jump_refused"
                  : p.failure.rfind("the branch ended", 0) == 0  ? "beyond_branch_end"
                                                                  : "no_steady_state";
+      // Past the located fold (on the far side from the branch's start): no
+      // steady state on this branch.
+      if (run.has_fold && (p.value - run.fold_value) * (run.fold_value - values.front()) > 0) {
+        b.status = "beyond_fold";
+        b.failure = "beyond the fold at " + formatValue(run.fold_value) + " (" + s_.key + "): " + b.failure;
+      }
     } else if (s_.stability) {
       const auto ts = std::chrono::steady_clock::now();
       b.stability = solver.calcStability(p.result);
@@ -296,6 +349,99 @@ BranchRun ContinuationAnalysis::follow(const BuiltScene& built) const {
     run.points.push_back(std::move(b));
   }
   return run;
+}
+
+Json ContinuationAnalysis::followLimit(const BuiltScene& built, SteadyStateSolver& solver, const SteadyStateResult& last,
+                                       double vLast, double vFail,
+                                       const std::function<void(SimTK::State&, double)>& setValue,
+                                       BranchRun& run) const {
+  const Scene& sc = built.scene();
+  const SimTK::MobilizedBody& chassis = sc.getBody(s_.chassis);
+  const std::vector<std::string> cols = s_.table_outputs.empty() ? built.outputs : s_.table_outputs;
+  const double gap = std::abs(vFail - vLast);
+  ArclengthOptions o;
+  o.direction = vFail > vLast ? +1 : -1;
+  o.step = 0.25 * gap;  // the grid's last step: a quarter first, grown up to the step
+  o.max_step = gap;
+  o.min_step = s_.fold_tolerance;
+  o.location_tolerance = s_.fold_tolerance;
+  o.max_points = 200;
+  o.stop_after_folds = 1;
+  o.points_after_last_fold = s_.past_fold_points;
+  // The branch is followed no farther than the grid reaches.
+  double lo = std::min(vLast, vFail), hi = std::max(vLast, vFail);
+  for (double v : s_.values) lo = std::min(lo, v), hi = std::max(hi, v);
+  o.lambda_min = lo - gap;
+  o.lambda_max = hi + gap;
+  // Lateral acceleration of the chassis origin in the steady turn: yaw rate x
+  // horizontal speed (m/s^2, + to the left).
+  auto lateral = [&](const SimTK::State& st) {
+    SimTK::State s = st;
+    sc.getSystem().realize(s, SimTK::Stage::Velocity);
+    const SimTK::Vec3 v = chassis.getBodyOriginVelocity(s);
+    return chassis.getBodyAngularVelocity(s)[2] * std::hypot(v[0], v[1]);
+  };
+  auto eigJson = [](const std::vector<std::complex<double>>& ev) {
+    Json e = Json::array();
+    for (const auto& z : ev) e.push_back({z.real(), z.imag()});
+    return e;
+  };
+  // The point's steady state, outputs and lateral acceleration (with the
+  // model at the point's value: a held steering angle is a model parameter).
+  auto describe = [&](const ArclengthPoint& p) {
+    const SteadyStateResult r = solver.makeDrivenResult(p.x, p.lambda);
+    Json outs = Json::object();
+    for (const auto& c : cols) outs[c] = sc.evalOutput(c, r.state);
+    Json j = {{"value", p.lambda}, {"arclength", p.s}, {"lateral_acceleration_m_s2", lateral(r.state)},
+              {"outputs", outs}};
+    if (p.have_eigenvalues) {
+      j["stable"] = p.stable;
+      j["least_damped_eigenvalue"] = p.eigenvalues.empty() ? Json::array({0, 0})
+                                                           : Json::array({p.eigenvalues.front().real(),
+                                                                          p.eigenvalues.front().imag()});
+    }
+    return std::make_pair(j, r);
+  };
+  Json limit = {{"from_value", vLast}, {"failed_value", vFail}, {"fold", nullptr}, {"hopf", Json::array()}};
+  ArclengthResult ar;
+  try {
+    ar = continueSteadyState(solver, last, vLast, setValue, gap, s_.stability, o);
+  } catch (const Error& e) {
+    limit["failure"] = e.what();
+    return limit;
+  }
+  Json points = Json::array();
+  for (const auto& p : ar.points) {
+    auto [j, r] = describe(p);
+    j["past_fold"] = !ar.special.empty() && ar.special.front().kind == "fold" ? p.s > ar.special.front().point.s : false;
+    std::vector<double> row = {p.lambda, p.s, p.have_eigenvalues ? double(p.stable) : NAN,
+                               p.have_eigenvalues && !p.eigenvalues.empty() ? p.eigenvalues.front().real() : NAN,
+                               p.have_eigenvalues && !p.eigenvalues.empty() ? p.eigenvalues.front().imag() : NAN,
+                               j.at("lateral_acceleration_m_s2").get<double>()};
+    for (const auto& c : cols) row.push_back(j.at("outputs").at(c).get<double>());
+    run.limit_rows.push_back(row);
+    points.push_back(j);
+  }
+  for (const auto& sp : ar.special) {
+    auto [j, r] = describe(sp.point);
+    j["located"] = sp.located;
+    j["bracket"] = sp.bracket_length;
+    j["location_iterations"] = sp.location_iterations;
+    j["eigenvalues"] = eigJson(sp.point.eigenvalues);
+    if (sp.kind == "fold" && limit.at("fold").is_null()) {
+      limit["fold"] = j;
+      run.has_fold = true;
+      run.fold_value = sp.point.lambda;
+    } else if (sp.kind == "hopf") {
+      limit["hopf"].push_back(j);
+    }
+  }
+  limit.update({{"points", points},
+                {"steps", ar.steps},
+                {"rejected_steps", ar.rejected_steps},
+                {"corrector_iterations", ar.corrector_iterations},
+                {"stop_reason", ar.stop_reason}});
+  return limit;
 }
 
 Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& run) const {
@@ -312,11 +458,18 @@ Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& r
       ++none;
       refused += p.status == "branch_jump_refused";
       pj["failure"] = p.failure;
-      if (p.status != "beyond_branch_end")
+      if (p.status != "beyond_branch_end" && lastStable != -2)
         labels.push_back({{"from_value", lastValue},
                           {"to_value", p.value},
-                          {"label", p.status == "branch_jump_refused" ? "branch_jump_refused" : "branch_end"},
+                          {"label", p.status == "branch_jump_refused" ? "branch_jump_refused"
+                                    : p.status == "beyond_fold"       ? "fold"
+                                                                      : "branch_end"},
                           {"reason", p.failure}});
+      if (p.status == "beyond_fold") {
+        lastStable = -2;  // one label for the fold
+        points.push_back(pj);
+        continue;
+      }
       lastStable = -1;
       points.push_back(pj);
       continue;
@@ -362,6 +515,8 @@ Json ContinuationAnalysis::summarize(const BuiltScene& built, const BranchRun& r
               {"largest_stable_value", largestStable},
               {"stability_wall_time_s", run.stability_wall_time_s}});
   if (!last.is_null()) j["last_converged_point"] = last;
+  j["limit"] = run.limit;
+  j["limit_value"] = run.has_fold ? Json(run.fold_value) : Json(nullptr);
   return j;
 }
 
@@ -387,6 +542,14 @@ AnalysisResult ContinuationAnalysis::DoRun(const AnalysisContext& ctx) const {
   AnalysisResult res;
   res.summary = summarize(ctx.built, run);
   res.tables.push_back({"continuation", t});
+  if (!run.limit_rows.empty()) {
+    Table l;
+    l.columns = {s_.key, "arclength", "stable", "least_damped_real_per_s", "least_damped_imag_per_s",
+                 "lateral_acceleration_m_s2"};
+    l.columns.insert(l.columns.end(), cols.begin(), cols.end());
+    l.rows = run.limit_rows;
+    res.tables.push_back({"limit", l});
+  }
   return res;
 }
 

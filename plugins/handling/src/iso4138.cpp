@@ -11,6 +11,8 @@ void ConstantRadiusSettings::validate() const {
   requirePositive(speed_start_m_s, "constant radius speed_start_m_s");
   requirePositive(speed_step_m_s, "constant radius speed_step_m_s");
   requirePositive(limit_tolerance_m_s, "constant radius limit_tolerance_m_s");
+  if (past_limit_points < 0)
+    throw Error("constant radius past_limit_points must be >= 0, got " + std::to_string(past_limit_points));
   if (!(speed_max_m_s >= speed_start_m_s))
     throw Error("constant radius speed_max_m_s (" + formatValue(speed_max_m_s) + ") is below speed_start_m_s (" +
                 formatValue(speed_start_m_s) + ")");
@@ -24,7 +26,11 @@ const FieldTable<ConstantRadiusSettings>& ConstantRadiusSettings::fields() {
           .number("speed_start_m_s", &S::speed_start_m_s, "m/s", "first speed")
           .number("speed_step_m_s", &S::speed_step_m_s, "m/s", "speed increment")
           .number("speed_max_m_s", &S::speed_max_m_s, "m/s", "last speed tried")
-          .number("limit_tolerance_m_s", &S::limit_tolerance_m_s, "m/s", "bisection tolerance of the limit speed")
+          .number("limit_tolerance_m_s", &S::limit_tolerance_m_s, "m/s",
+                  "arclength bracket to which the limit (the fold in speed) is located, and the continuation's "
+                  "smallest step")
+          .integer("past_limit_points", &S::past_limit_points, "",
+                   "pseudo-arclength points continued past the limit (the unstable branch at lower speeds)")
           .boolean("stability", &S::stability, "eigenvalues at each point");
   return t;
 }
@@ -130,7 +136,8 @@ ConstantRadiusResult runConstantRadius(const HandlingVehicle& v, const ConstantR
     return pts.front();
   };
 
-  double U = U0, step = set.speed_step_m_s;
+  const double step = set.speed_step_m_s;
+  double U = U0;
   while (U <= set.speed_max_m_s + 1e-12) {
     ContinuationPoint p = solveAt(U);
     if (!p.converged) {
@@ -138,22 +145,60 @@ ConstantRadiusResult runConstantRadius(const HandlingVehicle& v, const ConstantR
         throw Error("constant radius R = " + formatValue(R) + " m on '" + v.name + "': no steady state at the first speed " +
                     formatValue(U) + " m/s: " + p.failure);
       out.limit_reason = p.failure;
-      if (step <= set.limit_tolerance_m_s) {
-        out.limit_found = true;
-        break;
-      }
-      step *= 0.5;
-      U = branch.back().first + step;
-      continue;
+      break;
     }
     out.points.push_back(measure(U, p.result));
     branch.emplace_back(U, std::move(p.result));
-    // Near the fold the steering angle grows fast: the predictor needs small steps.
     U += step;
   }
   if (out.points.empty()) throw Error("constant radius: no point converged");
   out.limit_speed_m_s = out.points.back().speed_m_s;
   out.limit_lateral_accel_m_s2 = out.points.back().lateral_accel_m_s2;
+  if (!out.limit_reason.empty()) {
+    // The limit: the fold of the branch in speed (the largest speed on the
+    // radius), by pseudo-arclength continuation from the last converged point,
+    // located to limit_tolerance_m_s, and past_limit_points beyond it.
+    ArclengthOptions o;
+    o.step = 0.25 * step;
+    o.max_step = step;
+    o.min_step = o.location_tolerance = set.limit_tolerance_m_s;
+    o.max_points = 200;
+    o.stop_after_folds = 1;
+    o.points_after_last_fold = set.past_limit_points;
+    o.lambda_max = set.speed_max_m_s + step;
+    o.lambda_min = 0.5 * U0;
+    // The speed moves the rear angle of a speed-dependent strategy too.
+    const auto drive = [&v](SimTK::State& s, double Ud) {
+      v.speed->setSpeed(s, Ud);
+      v.holdSteering(Ud, v.front->getHeldAngle());
+    };
+    const auto ta = clock::now();
+    try {
+      const ArclengthResult ar =
+          continueSteadyState(solver, branch.back().second, branch.back().first, drive, step, set.stability, o);
+      out.limit_steps = ar.steps;
+      out.limit_rejected_steps = ar.rejected_steps;
+      const ArclengthSpecialPoint* fold = nullptr;
+      for (const auto& sp : ar.special)
+        if (sp.kind == "fold" && !fold) fold = &sp;
+      if (fold) {
+        const ConstantRadiusPoint f = measure(fold->point.lambda, solver.makeDrivenResult(fold->point.x, fold->point.lambda));
+        out.limit_found = true;
+        out.limit_speed_m_s = f.speed_m_s;
+        out.limit_lateral_accel_m_s2 = f.lateral_accel_m_s2;
+        out.limit_front_rad = f.front_rad;
+        out.limit_eigenvalues = fold->point.eigenvalues;
+        out.limit_bracket_m_s = fold->bracket_length;
+        for (const auto& q : ar.points)
+          if (q.s > fold->point.s) out.past_limit_points.push_back(measure(q.lambda, solver.makeDrivenResult(q.x, q.lambda)));
+      } else {
+        out.limit_reason += "; pseudo-arclength continuation found no fold (stopped: " + ar.stop_reason + ")";
+      }
+    } catch (const Error& e) {
+      out.limit_reason += "; pseudo-arclength continuation: " + std::string(e.what());
+    }
+    out.solve_wall_time_s += std::chrono::duration<double>(clock::now() - ta).count();
+  }
 
   // Understeer gradient: three-point differences of delta_f(a_y) along the sweep.
   auto& P = out.points;

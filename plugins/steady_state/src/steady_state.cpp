@@ -287,6 +287,7 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
   if (se.getNQ() != se_.getNQ() || se.getNU() != nu_ || se.getNZ() != nz_)
     throw Error("steady state: the start state does not belong to the solver's scene");
   se_ = se;
+  drivenLambda_ = std::numeric_limits<double>::quiet_NaN();  // the workspace holds the start's own model
   curP_ = p0;
   for (int i = 0; i < np_; ++i) problem_.parameters[i].set(se_, p0[i]);
   se_.invalidateAll(SimTK::Stage::Position);  // commands may have changed (model parameters)
@@ -408,13 +409,86 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
         "; worst equation (scaled): " + describeEquation(int(worst)) + " = " + formatValue(r[worst]) +
         " (no steady state may exist here: beyond the limit of adhesion or past a fold of the branch)");
   }
+  fillResult(x, r, res);
+  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return res;
+}
+
+bool SteadyStateSolver::meetsTolerances(const Eigen::VectorXd& r) const {
+  if (maxAbs(r.head(nu_)) > opt_.force_tolerance || maxAbs(r.segment(nu_, mp_)) > opt_.position_tolerance ||
+      maxAbs(r.segment(nu_ + mp_, mv_)) > opt_.velocity_tolerance || maxAbs(r.segment(nu_ + m_, nz_)) > opt_.rate_tolerance)
+    return false;
+  for (int i = 0; i < np_; ++i)
+    if (!(std::abs(r[nu_ + m_ + nz_ + i]) <= problem_.conditions[i].tolerance)) return false;
+  return r.allFinite();
+}
+
+void SteadyStateSolver::fillResult(const Eigen::VectorXd& x, const Eigen::VectorXd& r, SteadyStateResult& res) const {
+  res.force_residual = maxAbs(r.head(nu_));
+  res.position_error = maxAbs(r.segment(nu_, mp_));
+  res.velocity_error = maxAbs(r.segment(nu_ + mp_, mv_));
+  res.rate_residual = maxAbs(r.segment(nu_ + m_, nz_));
+  res.residual_norm = r.cwiseProduct(rScale_).norm();
+  res.condition_residual = maxAbs(r.tail(np_));
   res.multipliers.resize(m_);
   for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nu_ + i];
   res.parameters.assign(x.data() + nu_ + m_ + nz_, x.data() + n_);
   res.euler_state = se_;
   res.state = toQuaternions(scene_, se_);
-  system.realize(res.state, SimTK::Stage::Velocity);
-  res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  scene_.getSystem().realize(res.state, SimTK::Stage::Velocity);
+}
+
+// --- pseudo-arclength continuation's pieces -------------------------------------
+void SteadyStateSolver::beginDriven(const SteadyStateResult& start, std::function<void(SimTK::State&, double)> drive,
+                                    double lambda_scale) {
+  if (!drive) throw Error("steady state continuation: no driving condition");
+  requirePositive(lambda_scale, "steady state continuation: typical size of the driving condition");
+  SimTK::State se = start.euler_state;
+  se.setTime(problem_.time_s);
+  scene_.getSystem().realize(se, SimTK::Stage::Instance);
+  se_ = se;
+  curP_ = start.parameters.size() == std::size_t(np_) ? start.parameters : curP_;
+  for (int i = 0; i < np_; ++i) problem_.parameters[i].set(se_, curP_[i]);
+  se_.invalidateAll(SimTK::Stage::Position);
+  drive_ = std::move(drive);
+  driveScale_ = lambda_scale;
+  drivenLambda_ = std::numeric_limits<double>::quiet_NaN();
+  haveJacobian_ = false;  // the next solve() takes a fresh Jacobian
+}
+
+void SteadyStateSolver::applyDrive(double lambda) const {
+  if (!drive_) throw Error("steady state continuation: beginDriven was not called");
+  if (lambda == drivenLambda_) return;
+  drive_(se_, lambda);
+  se_.invalidateAll(SimTK::Stage::Position);  // the model changed
+  drivenLambda_ = lambda;
+}
+
+Eigen::VectorXd SteadyStateSolver::calcDrivenEquations(const Eigen::VectorXd& x, double lambda) const {
+  applyDrive(lambda);
+  return calcEquations(x);
+}
+
+Eigen::MatrixXd SteadyStateSolver::calcDrivenJacobian(const Eigen::VectorXd& x, double lambda,
+                                                      const Eigen::VectorXd& r) const {
+  applyDrive(lambda);
+  Eigen::MatrixXd Jx;
+  calcJacobian(x, r, Jx);
+  Eigen::MatrixXd J(n_, n_ + 1);
+  J.leftCols(n_) = Jx;
+  const double h = 1.5e-8 * std::max(std::abs(lambda), driveScale_);
+  applyDrive(lambda + h);
+  J.col(n_) = (calcEquations(x) - r) / h;
+  applyDrive(lambda);
+  setUnknowns(x);
+  return J;
+}
+
+SteadyStateResult SteadyStateSolver::makeDrivenResult(const Eigen::VectorXd& x, double lambda) const {
+  applyDrive(lambda);
+  const Eigen::VectorXd r = calcEquations(x);
+  SteadyStateResult res;
+  fillResult(x, r, res);
   return res;
 }
 
@@ -758,6 +832,26 @@ std::vector<double> calcSteadyStateSensitivity(
   std::vector<double> d(fp.size());
   for (std::size_t i = 0; i < fp.size(); ++i) d[i] = (fp[i] - fm[i]) / (2 * h);  // (4.49)
   return d;
+}
+
+ArclengthResult continueSteadyState(SteadyStateSolver& solver, const SteadyStateResult& start, double value0,
+                                    const std::function<void(SimTK::State&, double)>& setCondition,
+                                    double value_scale, bool stability, const ArclengthOptions& options) {
+  solver.beginDriven(start, setCondition, value_scale);
+  ArclengthSystem sys;
+  sys.x_scale = solver.getUnknownScales();
+  sys.lambda_scale = value_scale;
+  sys.r_scale = solver.getEquationScales();
+  sys.residual = [&solver](const Eigen::VectorXd& x, double v) { return solver.calcDrivenEquations(x, v); };
+  sys.jacobian = [&solver](const Eigen::VectorXd& x, double v, const Eigen::VectorXd& r) {
+    return solver.calcDrivenJacobian(x, v, r);
+  };
+  sys.converged = [&solver](const Eigen::VectorXd& r) { return solver.meetsTolerances(r); };
+  if (stability)
+    sys.eigenvalues = [&solver, &options](const Eigen::VectorXd& x, double v) {
+      return solver.calcStability(solver.makeDrivenResult(x, v), options.stability_tolerance).eigenvalues;
+    };
+  return continueArclength(sys, solver.getUnknowns(start), value0, options);
 }
 
 }  // namespace vdyn

@@ -32,6 +32,19 @@ struct BranchPoint {
 struct BranchRun {
   std::vector<BranchPoint> points;  ///< one per "values" entry (lead values not included)
   double solve_wall_time_s = 0, stability_wall_time_s = 0;
+  /// When a point failed after a converged one: pseudo-arclength continuation
+  /// (continueSteadyState) from the last converged point towards the failed
+  /// value, through the fold and past_fold_points beyond it. "limit" of the
+  /// summary: {"fold": {value, lateral_acceleration_m_s2, eigenvalues,
+  /// located, bracket, location_iterations, outputs} or null, "hopf": [...],
+  /// "points": [...], steps, rejected_steps, corrector_iterations,
+  /// stop_reason[, failure]}; null when the branch did not end.
+  Json limit;
+  double fold_value = 0;  ///< the fold's value when limit.fold is not null (key's unit)
+  bool has_fold = false;
+  /// Rows of the arclength table (value, arclength, stable, least-damped
+  /// eigenvalue, lateral acceleration, outputs).
+  std::vector<std::vector<double>> limit_rows;
 };
 
 /// "analysis": {"type": "continuation", ...}: the steady state as a plugin's
@@ -53,6 +66,8 @@ class ContinuationAnalysis : public Analysis {
     int max_bisections = 4;
     std::string branch_output;          ///< "": no branch check
     double branch_max_change_factor = 2;
+    int past_fold_points = 3;           ///< arclength points continued past the fold
+    double fold_tolerance = 1e-7;       ///< bracket length of the located fold / Hopf point, key's unit
   };
   explicit ContinuationAnalysis(const ParamReader& settings);
   const Settings& settings() const { return s_; }
@@ -75,6 +90,10 @@ class ContinuationAnalysis : public Analysis {
   AnalysisResult DoRun(const AnalysisContext& ctx) const override;
 
  private:
+  /// Pseudo-arclength continuation from `last` (converged at vLast) towards
+  /// vFail (failed): BranchRun::limit, fold_value, has_fold, limit_rows.
+  Json followLimit(const BuiltScene& built, SteadyStateSolver& solver, const SteadyStateResult& last, double vLast,
+                   double vFail, const std::function<void(SimTK::State&, double)>& setValue, BranchRun& run) const;
   Settings s_;
 };
 

@@ -3,8 +3,9 @@
 // steady-state solve (plugins/steady_state): the path radius R of the chassis
 // origin is fixed by the extra condition U_h - r R = 0 (U_h its horizontal
 // speed, r the yaw rate) and the front steering angle is the extra unknown;
-// the speed U0 (3.18) is continued upward until no steady state exists (the
-// limit, located by bisection) or speed_max_m_s. At each point: steering
+// the speed U0 (3.18) is continued upward until no steady state exists or
+// speed_max_m_s; the limit is the fold of the branch in speed, located by
+// pseudo-arclength continuation (vdyn/steady_state/arclength.h). At each point: steering
 // angle, side slip, roll angle, lateral acceleration a_y (along the heading's
 // horizontal left, = U_h r cos(beta)), the
 // understeer gradient d delta_f / d a_y (deg per m/s^2) and the fixed-control
@@ -20,7 +21,7 @@ namespace vdyn {
 
 struct ConstantRadiusSettings {
   /// Keys radius_m, speed_start_m_s, speed_step_m_s, speed_max_m_s,
-  /// limit_tolerance_m_s, stability (each optional; defaults below).
+  /// limit_tolerance_m_s, past_limit_points, stability (each optional; defaults below).
   static ConstantRadiusSettings fromParams(const ParamReader& r);
   /// The keys (read by fromParams, listed by `vdyn list`).
   static const FieldTable<ConstantRadiusSettings>& fields();
@@ -29,7 +30,8 @@ struct ConstantRadiusSettings {
   double speed_start_m_s = 4;         ///< first speed, m/s
   double speed_step_m_s = 1;          ///< speed increment of the sweep, m/s
   double speed_max_m_s = 60;          ///< last speed tried if the limit is not met first, m/s
-  double limit_tolerance_m_s = 0.005; ///< the limit speed is bisected to this, m/s
+  double limit_tolerance_m_s = 0.005; ///< the limit (fold in speed) is located to this arclength bracket, m/s
+  int past_limit_points = 3;          ///< pseudo-arclength points continued past the limit
   bool stability = true;              ///< linearise at each point (eigenvalues)
   SteadyStateOptions solver;
   void validate() const;
@@ -58,10 +60,21 @@ struct ConstantRadiusPoint {
 struct ConstantRadiusResult {
   double radius_m = 0;
   std::vector<ConstantRadiusPoint> points;  ///< ascending speed (bisection points of the limit included)
-  double limit_speed_m_s = 0;               ///< last speed with a steady state, m/s
+  /// The limit: the fold of the steady states in speed (the largest speed on
+  /// the radius), located by pseudo-arclength continuation from the last
+  /// converged point to limit_tolerance_m_s; without a fold (speed_max_m_s
+  /// reached, or no fold found) the last converged point, m/s.
+  double limit_speed_m_s = 0;
   double limit_lateral_accel_m_s2 = 0;      ///< a_y there, m/s^2
-  bool limit_found = false;                 ///< false: speed_max_m_s reached with a steady state
-  std::string limit_reason;                 ///< the solver's message beyond the limit
+  bool limit_found = false;                 ///< true: the fold was located
+  std::string limit_reason;                 ///< the solver's message at the first speed past the limit
+  double limit_front_rad = 0;               ///< front angle at the fold, rad
+  std::vector<std::complex<double>> limit_eigenvalues;  ///< at the fold (with stability), 1/s
+  double limit_bracket_m_s = 0;             ///< final bracket of the fold's location, m/s
+  int limit_steps = 0, limit_rejected_steps = 0;  ///< pseudo-arclength steps (accepted, rejected)
+  /// Points past the fold on the branch (speed decreasing again, higher a_y):
+  /// the unstable part a vehicle does not hold.
+  std::vector<ConstantRadiusPoint> past_limit_points;
   /// First speed / lateral acceleration without stability (NaN if stable throughout),
   /// linearly interpolated on the least-damped real part between the last stable
   /// and the first unstable point.

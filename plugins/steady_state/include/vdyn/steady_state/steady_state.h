@@ -22,6 +22,7 @@
 // between fresh Jacobians, and a backtracking line search on a scaled merit.
 #include <complex>
 #include <functional>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,7 @@
 
 #include "vdyn/core/error.h"
 #include "vdyn/core/scene.h"
+#include "vdyn/steady_state/arclength.h"
 
 namespace vdyn {
 
@@ -216,7 +218,27 @@ class SteadyStateSolver {
   Eigen::VectorXd calcEquations(const Eigen::VectorXd& x) const;
   int numUnknowns() const { return n_; }
 
+  /// Pseudo-arclength continuation in a driving condition lambda (a held
+  /// steering angle, a held speed) that `drive(state, lambda)` applies to a
+  /// state's model (continueSteadyState). beginDriven takes the start's
+  /// model and time into the workspace; then calcDrivenEquations gives
+  /// F(x; lambda), calcDrivenJacobian [dF/dx, dF/dlambda] (n x (n + 1),
+  /// forward differences, lambda's step 1.5e-8 max(|lambda|, lambda_scale)),
+  /// and makeDrivenResult the steady state at a solution (the model left set
+  /// to lambda).
+  void beginDriven(const SteadyStateResult& start, std::function<void(SimTK::State&, double)> drive,
+                   double lambda_scale);
+  Eigen::VectorXd calcDrivenEquations(const Eigen::VectorXd& x, double lambda) const;
+  Eigen::MatrixXd calcDrivenJacobian(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& r) const;
+  SteadyStateResult makeDrivenResult(const Eigen::VectorXd& x, double lambda) const;
+  /// True when equations r meet every tolerance of the options and conditions.
+  bool meetsTolerances(const Eigen::VectorXd& r) const;
+  const Eigen::VectorXd& getUnknownScales() const { return xScale_; }    ///< typical sizes of the unknowns
+  const Eigen::VectorXd& getEquationScales() const { return rScale_; }   ///< equation weights (to newtons)
+
  private:
+  void applyDrive(double lambda) const;
+  void fillResult(const Eigen::VectorXd& x, const Eigen::VectorXd& r, SteadyStateResult& res) const;
   void setUnknowns(const Eigen::VectorXd& x) const;
   SteadyStateResult solveFrom(SimTK::State se, const SimTK::Vector& lambda0, const std::vector<double>& p0);
   void calcJacobian(const Eigen::VectorXd& x, const Eigen::VectorXd& r, Eigen::MatrixXd& J) const;
@@ -235,6 +257,9 @@ class SteadyStateSolver {
   mutable int evaluations_ = 0;
   Eigen::MatrixXd J_;
   bool haveJacobian_ = false;
+  std::function<void(SimTK::State&, double)> drive_;  // driving condition of continueSteadyState
+  double driveScale_ = 1;
+  mutable double drivenLambda_ = std::numeric_limits<double>::quiet_NaN();  // lambda the workspace holds
 };
 
 /// One point of a continuation.
@@ -281,5 +306,16 @@ std::vector<double> calcSteadyStateSensitivity(
     SteadyStateSolver& solver, const SteadyStateResult& nominal, double p0, double typical,
     const std::function<void(SimTK::State&, double)>& setCondition,
     const std::function<std::vector<double>(const SimTK::State&)>& outputs, double h = 0);
+
+/// Pseudo-arclength continuation (vdyn/steady_state/arclength.h) of a steady
+/// state in a driving condition that `setCondition(state, value)` applies (a
+/// held steering angle, a held speed), from the converged `start` at value0,
+/// through folds; with `stability` each point carries the eigenvalues of
+/// calcStability (Hopf test, stable/unstable labels). value_scale: the
+/// condition's typical size (its unit), the arclength metric's lambda scale.
+/// A point's steady state: solver.makeDrivenResult(point.x, point.lambda).
+ArclengthResult continueSteadyState(SteadyStateSolver& solver, const SteadyStateResult& start, double value0,
+                                    const std::function<void(SimTK::State&, double)>& setCondition,
+                                    double value_scale, bool stability, const ArclengthOptions& options);
 
 }  // namespace vdyn

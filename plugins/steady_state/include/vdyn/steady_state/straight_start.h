@@ -1,0 +1,32 @@
+#pragma once
+// The steady state on the branch connected to straight running (issue 22,
+// item 1): a homotopy in the time at which the commands are evaluated.
+#include <functional>
+#include <string>
+
+#include "vdyn/steady_state/steady_state.h"
+
+namespace vdyn {
+
+struct StraightStartReport {
+  int arclength_steps = 0;     ///< pseudo-arclength steps of the homotopy
+  int rejected_steps = 0;      ///< failed correctors (halved steps)
+  int corrector_iterations = 0;
+};
+
+/// The steady state at the solver's problem time_s on the branch that
+/// continues from straight running: the steady state at command time 0 (the
+/// commands before they move, e.g. a steering smooth step from 0) is solved
+/// directly from `initial`, and the command time is continued from 0 to time_s
+/// by pseudo-arclength continuation (continueSteadyState); the point at time_s
+/// is then solved by Newton from the branch's two neighbouring points
+/// (interpolated). A fold on the way is the Error "no steady state on the
+/// branch from straight running: fold at front steer X deg (lateral
+/// acceleration Y m/s^2)" (frontSteer(state) gives X in rad, or none if
+/// empty; Y is the yaw rate x horizontal speed of the floating base). With
+/// time_s = 0 it is the direct solve from `initial`.
+SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scene& scene, const SimTK::State& initial,
+                                           const std::function<double(const SimTK::State&)>& frontSteer,
+                                           StraightStartReport* report = nullptr);
+
+}  // namespace vdyn
