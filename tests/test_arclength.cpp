@@ -167,7 +167,7 @@ const double kDeg = SimTK::Pi / 180;
 TEST(Arclength, BicycleFoldInSteeringAgreesWithTheLastConvergedPointAndPassesIt) {
   const double U = 20.0;
   BicycleParams p = BicycleParams::fromFile("bicycle.json");
-  p.tire_plugin = "gim";
+  p.tire.plugin = "gim";
   Bicycle bike(p);
   auto steer = std::make_shared<HoldCommand>(0.0);
   bike.addFrontSteering("front_steer", steer);
@@ -239,7 +239,7 @@ TEST(Arclength, SteadyStateFromStraightRunningStopsAtTheFold) {
   const double U = 20.0;
   auto solveWith = [&](double finalDeg, bool straight) {
     BicycleParams p = BicycleParams::fromFile("bicycle.json");
-    p.tire_plugin = "gim";
+    p.tire.plugin = "gim";
     Bicycle bike(p);
     bike.addFrontSteering("front_steer", std::make_shared<SmoothStepCommand>(0.0, finalDeg * kDeg, 0.5, 1.0));
     bike.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U));
