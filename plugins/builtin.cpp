@@ -1,6 +1,7 @@
 #include "vdyn/plugins/builtin.h"
 
 #include "vdyn/forces/body_force.h"
+#include "vdyn/magic_formula/magic_formula_tire.h"
 #include "vdyn/path_control/path_control.h"
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/speed/speed_hold.h"
@@ -10,6 +11,7 @@
 namespace vdyn {
 void registerBuiltinPlugins(PluginRegistry& r) {
   registerTirePlugins(r);
+  registerMagicFormulaTire(r);
   registerBodyForcePlugins(r);
   registerSteeringPlugins(r);
   registerSpeedPlugins(r);

@@ -67,7 +67,7 @@ TEST(DataFile, UnknownTirePluginListsKnownOnes) {
   j["tire"]["plugin"] = "pacejka";
   // The ride-height spring is computed while parsing, so parsing builds the car.
   EXPECT_EQ(errorOf([&] { parse(j); }),
-            "quarter car tire plugin: unknown force element plugin 'pacejka'; known: body_force, fiala, gim, linear");
+            "quarter car tire plugin: unknown force element plugin 'pacejka'; known: body_force, fiala, gim, linear, magic_formula");
 }
 
 TEST(DataFile, UnknownRoadTypeListsKnownOnes) {

@@ -82,7 +82,7 @@ TEST(FourWs, UnknownTirePluginListsKnownOnes) {
     FourWsVehicle car(p);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "4ws tire plugin: unknown force element plugin 'magic'; known: body_force, fiala, gim, linear");
+    EXPECT_STREQ(e.what(), "4ws tire plugin: unknown force element plugin 'magic'; known: body_force, fiala, gim, linear, magic_formula");
   }
 }
 

@@ -113,7 +113,7 @@ Bicycle::Bicycle(const BicycleParams& params, const PluginRegistry& registry)
                          {"tire_rr", "rear_axle", -p_.rear_track_m / 2}, {"tire_rl", "rear_axle", p_.rear_track_m / 2}};
   for (const Spec& t : specs) {
     // Both tires of an axle take the slip of the axle centre (see bicycle.h).
-    const Json entry{{"centre_m", {0.0, t.y, 0.0}}, {"slip_centre_m", {0.0, 0.0, 0.0}}};
+    const Json entry{{"centre_m", {0.0, t.y, 0.0}}, {"slip_centre_m", {0.0, 0.0, 0.0}}, {"side", t.y < 0 ? "right" : "left"}};
     const PluginSpec spec = p_.tire.makeSpec(t.name, t.body, entry);
     tires_.push_back(dynamic_cast<const TirePlugin*>(
         &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire.plugin, spec, "bicycle tire plugin"))));

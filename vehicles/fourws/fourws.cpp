@@ -98,7 +98,8 @@ FourWsVehicle::FourWsVehicle(const FourWsParams& params, const PluginRegistry& r
     } else {
       corners_[c] = buildDoubleWishbone(sc, chassis_, cornerParams_[c], prefix);
     }
-    const PluginSpec spec = p_.tire.makeSpec(std::string("tire_") + cornerName(c), prefix + "wheel");
+    const PluginSpec spec = p_.tire.makeSpec(std::string("tire_") + cornerName(c), prefix + "wheel",
+                                             Json{{"side", c == RF || c == RR ? "right" : "left"}});
     tires_[c] = dynamic_cast<const TirePlugin*>(
         &sc.addPlugin(registry.create(PluginKind::ForceElement, p_.tire.plugin, spec, "4ws tire plugin")));
     if (!tires_[c]) throw Error("4ws tire plugin '" + p_.tire.plugin + "' is not a tire plugin");

@@ -150,7 +150,8 @@ void TireForceImpl::calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::Spati
   const TireForces& f = c.forces;
   const Vec3 F_G = c.R_GC * Vec3(f.fx_N, f.fy_N, f.fz_N);
   const Vec3 s_G = wheel_.getBodyRotation(s) * Vec3(spinAxis_W_);
-  const Vec3 M_G = f.mz_N_m * c.R_GC.z() + f.my_N_m * s_G;
+  Vec3 M_G = f.mz_N_m * c.R_GC.z() + f.my_N_m * s_G;
+  if (f.mx_N_m != 0) M_G += f.mx_N_m * c.R_GC.x();
   const Vec3 r_GP = c.p_GC - wheel_.getBodyOriginLocation(s);  // moment about the body origin
   bodyForces[wheel_.getMobilizedBodyIndex()] += SimTK::SpatialVec(M_G + SimTK::cross(r_GP, F_G), F_G);
 }
@@ -273,64 +274,16 @@ PluginSpec TireChoice::makeSpec(const std::string& name, const std::string& whee
 
 double calcStaticDeflection(const TireModel& model, double fz) { return fz / model.vertical().radial_stiffness_N_per_m; }
 
-namespace {
-/// The keys of a tire plugin entry: where the tire sits, and its kind's params P.
-template <class P>
-struct TireSpec {
-  std::string wheel;
-  SimTK::Vec3 spin_axis{0, 1, 0};
-  SimTK::Vec3 centre_m{0, 0, 0};
-  bool has_slip_centre = false;
-  SimTK::Vec3 slip_centre_m{0, 0, 0};
-  P params;
-};
-template <class P>
-const FieldTable<TireSpec<P>>& tireSpecFields() {
-  using S = TireSpec<P>;
-  static const auto t =
-      FieldTable<S>()
-          .custom("wheel", "-", "required", "wheel body (bindable: attach a corner)",
-                  [](const ParamReader& r, S& s) { if (r.has("wheel")) s.wheel = r.string("wheel"); })
-          .sample("\"wheel\"")
-          .vec3("spin_axis", &S::spin_axis, "-", "spin axis in the wheel frame")
-          .vec3("centre_m", &S::centre_m, "m", "tire centre on the wheel's spin axis, wheel frame")
-          .custom("slip_centre_m", "m", "centre_m", "where slip velocities are taken, wheel frame",
-                  [](const ParamReader& r, S& s) {
-                    s.has_slip_centre = r.has("slip_centre_m");
-                    if (s.has_slip_centre) s.slip_centre_m = r.vec3("slip_centre_m");
-                  })
-          .sample("[0, 0, 0]")
-          .object("params", &S::params, P::fields(), "tire parameters (the keys 'params: ...')");
-  return t;
-}
-
-/// Registers tire kind `type` with parameter struct P and model class M.
-template <class P, class M>
-void registerTireKind(PluginRegistry& registry, const std::string& type, const std::string& summary) {
-  registry.add(
-      PluginKind::ForceElement, type,
-      [type](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
-        const TireSpec<P> s = tireSpecFields<P>().read(spec.params);
-        if (spec.params.has("params")) {
-          const ParamReader p = spec.params.child("params");
-          p.requireAllKeysRead();  // an unknown tire key is an error, with the nearest key as a hint
-          s.params.validate(p.where());
-        }
-        auto plugin = std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"), std::make_shared<M>(s.params),
-                                                   SimTK::UnitVec3(s.spin_axis), "road", s.centre_m);
-        if (s.has_slip_centre) plugin->setSlipCentre(s.slip_centre_m);
-        return plugin;
-      },
-      typeInfo(summary + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad", tireSpecFields<P>()));
-}
-}  // namespace
-
 void registerTirePlugins(PluginRegistry& registry) {
-  registerTireKind<BrushTireParams, GimTire>(
-      registry, "gim", "the seed's analytical comprehensive-slip tire (Gim and Nikravesh) on a wheel body");
-  registerTireKind<BrushTireParams, FialaTire>(registry, "fiala", "the Fiala tire as published, on a wheel body");
-  registerTireKind<LinearTireParams, LinearTire>(
-      registry, "linear", "linear tire Fx = C_s kappa, Fy = -C_a alpha (no saturation), on a wheel body");
+  // The brush and linear laws are symmetric: the wheel's side does not matter.
+  registerTireKind<BrushTireParams>(
+      registry, "gim", "the seed's analytical comprehensive-slip tire (Gim and Nikravesh) on a wheel body",
+      [](const BrushTireParams& p, WheelSide) { return std::make_shared<GimTire>(p); });
+  registerTireKind<BrushTireParams>(registry, "fiala", "the Fiala tire as published, on a wheel body",
+                                    [](const BrushTireParams& p, WheelSide) { return std::make_shared<FialaTire>(p); });
+  registerTireKind<LinearTireParams>(
+      registry, "linear", "linear tire Fx = C_s kappa, Fy = -C_a alpha (no saturation), on a wheel body",
+      [](const LinearTireParams& p, WheelSide) { return std::make_shared<LinearTire>(p); });
 }
 
 }  // namespace vdyn

@@ -147,7 +147,7 @@ double TireModel::calcNormalForce(const ContactKinematics& k) const {
                            vertical_.radial_damping_N_s_per_m * k.deflection_rate_m_s);
 }
 
-double TireModel::calcRollingRadius(double d) const {
+double TireModel::DoCalcRollingRadius(double d) const {
   return vertical_.unloaded_radius_m - vertical_.rolling_radius_deflection_factor * std::max(0.0, d);
 }
 

@@ -1,5 +1,6 @@
 #pragma once
 // The tire as a Simbody force element on a wheel body, and its plugin.
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -152,6 +153,72 @@ struct TireChoice {
 
 /// The static radial deflection of `model` under normal load fz_N (Fz = Kz delta), m.
 double calcStaticDeflection(const TireModel& model, double fz_N);
+
+namespace detail {
+/// The keys of a tire plugin entry: where the tire sits, and its kind's params P.
+template <class P>
+struct TireSpec {
+  std::string wheel;
+  SimTK::Vec3 spin_axis{0, 1, 0};
+  SimTK::Vec3 centre_m{0, 0, 0};
+  bool has_slip_centre = false;
+  SimTK::Vec3 slip_centre_m{0, 0, 0};
+  std::string side;
+  P params;
+};
+template <class P>
+const FieldTable<TireSpec<P>>& tireSpecFields() {
+  using S = TireSpec<P>;
+  static const auto t =
+      FieldTable<S>()
+          .custom("wheel", "-", "required", "wheel body (bindable: attach a corner)",
+                  [](const ParamReader& r, S& s) { if (r.has("wheel")) s.wheel = r.string("wheel"); })
+          .sample("\"wheel\"")
+          .vec3("spin_axis", &S::spin_axis, "-", "spin axis in the wheel frame")
+          .vec3("centre_m", &S::centre_m, "m", "tire centre on the wheel's spin axis, wheel frame")
+          .custom("slip_centre_m", "m", "centre_m", "where slip velocities are taken, wheel frame",
+                  [](const ParamReader& r, S& s) {
+                    s.has_slip_centre = r.has("slip_centre_m");
+                    if (s.has_slip_centre) s.slip_centre_m = r.vec3("slip_centre_m");
+                  })
+          .sample("[0, 0, 0]")
+          .custom("side", "-", "\"\"", "left | right: the vehicle side of the wheel (a handed law mirrors; set by the vehicle)",
+                  [](const ParamReader& r, S& s) {
+                    s.side = r.stringOr("side", "");
+                    if (!s.side.empty() && s.side != "left" && s.side != "right")
+                      throw Error(r.at("side") + ": expected left or right, got '" + s.side + "'");
+                  })
+          .sample("\"left\"")
+          .object("params", &S::params, P::fields(), "tire parameters (the keys 'params: ...')");
+  return t;
+}
+}  // namespace detail
+
+/// Registers tire kind `type` as a force-element plugin: its entry takes the
+/// keys every tire has (wheel, spin_axis, centre_m, slip_centre_m, side) and
+/// "params" read through P's field table (P::fields(), P::validate(where));
+/// `makeModel` builds the law from them for a wheel on `side`.
+template <class P>
+void registerTireKind(PluginRegistry& registry, const std::string& type, const std::string& summary,
+                      std::function<std::shared_ptr<const TireModel>(const P&, WheelSide)> makeModel) {
+  registry.add(
+      PluginKind::ForceElement, type,
+      [type, makeModel](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
+        const detail::TireSpec<P> s = detail::tireSpecFields<P>().read(spec.params);
+        if (spec.params.has("params")) {
+          const ParamReader p = spec.params.child("params");
+          p.requireAllKeysRead();  // an unknown tire key is an error, with the nearest key as a hint
+          s.params.validate(p.where());
+        }
+        const WheelSide side = s.side == "left" ? WheelSide::Left : s.side == "right" ? WheelSide::Right : WheelSide::Unknown;
+        auto plugin = std::make_unique<TirePlugin>(type, spec.name, spec.bound("wheel"), makeModel(s.params, side),
+                                                   SimTK::UnitVec3(s.spin_axis), "road", s.centre_m);
+        if (s.has_slip_centre) plugin->setSlipCentre(s.slip_centre_m);
+        return plugin;
+      },
+      typeInfo(summary + "; outputs <name>.Fx_N, Fy_N, Fz_N, Mz_N_m, slip_ratio, slip_angle_rad",
+               detail::tireSpecFields<P>()));
+}
 
 /// Registers the tire plugins "gim", "fiala" (BrushTireParams) and "linear"
 /// (LinearTireParams). Parameters:

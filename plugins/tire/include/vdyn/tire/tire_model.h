@@ -95,6 +95,10 @@ struct LinearTireParams {
   static const FieldTable<LinearTireParams>& fields();
 };
 
+/// The side of the vehicle a wheel is on, for a tire law that is not
+/// symmetric (a .tir file measured on one side is mirrored on the other).
+enum class WheelSide { Unknown, Left, Right };
+
 /// Kinematics of the contact, computed by the force element (or given by a test).
 struct ContactKinematics {
   double deflection_m = 0;         ///< radial deflection delta along the normal, >= 0 in contact
@@ -114,6 +118,7 @@ struct ContactKinematics {
 /// Forces on the wheel in C, and slip diagnostics.
 struct TireForces {
   double fx_N = 0, fy_N = 0, fz_N = 0;  ///< force at the contact point
+  double mx_N_m = 0;                    ///< overturning moment about x_C (0 for the brush and linear tires)
   double my_N_m = 0;                    ///< rolling-resistance moment about the spin axis
   double mz_N_m = 0;                    ///< aligning moment about z_C
   double slip_ratio = 0;                ///< longitudinal slip, > 0 driving ((Omega Re - Vx)/den)
@@ -132,10 +137,11 @@ class TireModel {
   TireForces calcForces(const ContactKinematics& k) const;
   /// Normal force Fz = max(0, Kz delta + Cz delta'), N.
   double calcNormalForce(const ContactKinematics& k) const;
-  /// Effective rolling radius Re = R1 - f delta, m (f =
+  /// Effective rolling radius Re, m: R1 - f delta by default (f =
   /// rolling_radius_deflection_factor, 1/3 by default: the usual approximation
-  /// for a radial tire between loaded and unloaded radius).
-  double calcRollingRadius(double deflection_m) const;
+  /// for a radial tire between loaded and unloaded radius); a kind may
+  /// override it (DoCalcRollingRadius).
+  double calcRollingRadius(double deflection_m) const { return DoCalcRollingRadius(deflection_m); }
   /// Elastic energy of the radial spring, Kz delta^2 / 2, J.
   double calcPotentialEnergy(double deflection_m) const;
   /// Relaxation lengths (sigma_x, sigma_y) at normal load fz_N, m; 0 where that
@@ -146,6 +152,7 @@ class TireModel {
   TireModel(const TireVerticalParams& vertical, const TireSlipParams& slip, const std::string& where);
   /// Tangential forces and moments; called only in contact, with fz_N set.
   virtual void DoCalcTangential(const ContactKinematics& k, TireForces& f) const = 0;
+  virtual double DoCalcRollingRadius(double deflection_m) const;
   virtual std::pair<double, double> DoCalcRelaxationLengths(double /*fz_N*/) const {
     return {slip_.relaxation_length_longitudinal_m, slip_.relaxation_length_lateral_m};
   }
