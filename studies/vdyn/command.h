@@ -33,6 +33,7 @@ int runCommand(const std::vector<std::string>& args);
 int checkCommand(const std::vector<std::string>& args);
 int listCommand(const std::vector<std::string>& args);
 int sweepCommand(const std::vector<std::string>& args);
+int tireCommand(const std::vector<std::string>& args);
 
 /// The command table (vdyn_main.cpp).
 const std::vector<Command>& commands();

@@ -3,6 +3,7 @@
 //   vdyn check SCENE [--set ...] [--plugin PATH ...]
 //   vdyn list [NAME] [--plugin PATH ...]   (NAME: a kind, a choice family or a type name)
 //   vdyn sweep SWEEP [--threads N] [--out DIR] ...; mpirun -n N vdyn sweep SWEEP --mpi
+//   vdyn tire TIRE_DATA [--fz N,...] [--alpha DEG,...] [--kappa ...] [--gamma DEG,...] [--out DIR]
 // One source file per subcommand (run_command.cpp, check_command.cpp, list_command.cpp, sweep_command.cpp), listed in the
 // table below.
 #include <cstdio>
@@ -28,6 +29,10 @@ const std::vector<Command>& commands() {
                 "mpirun -n N vdyn sweep SWEEP --mpi",
        "run a scene over a sweep file's variations on threads or MPI processes; one CSV/JSON ordered by variation",
        &sweepCommand},
+      {"tire", "tire TIRE_DATA [--fz N,...] [--alpha DEG,...] [--kappa K,...] [--gamma DEG,...] [--vx M_S] [--out DIR] "
+               "[--no-plots] [--plugin PATH ...]",
+       "any registered tire on its own in steady state: CSV of forces and moments over a grid, and the plots "
+       "Fy-alpha, Mz-alpha, Fx-kappa and the friction ellipse", &tireCommand},
   };
   return table;
 }
