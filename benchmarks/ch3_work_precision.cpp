@@ -3,7 +3,7 @@
 // steering closed by constraint rows; reduced: the loops solved in the
 // knuckle's mobilizer, its arm, steering and speed rows solved by Simbody;
 // dense: the reduced model with those rows solved as one dense system,
-// FourWsVehicle::useDenseRows), each integrator at accuracies 1e-3 .. 1e-8
+// WheeledVehicle::useDenseRows), each integrator at accuracies 1e-3 .. 1e-8
 // against a reference at 1e-10 of the same model (the dense model's errors
 // against the reduced model's reference, which Simbody projects).
 //
@@ -20,7 +20,7 @@
 // Headline: the data file's integrator and accuracy, --repeats runs of each
 // model alternately; medians of CPU time and RTF and the same-run ratio.
 // Both models start from the same state (the reduced one from the
-// constrained one's assembled initial state, FourWsVehicle::makeStateLike).
+// constrained one's assembled initial state, WheeledVehicle::makeStateLike).
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -30,7 +30,7 @@
 #include "ch3_case.h"
 #include "study.h"
 #include "vdyn/core/simulation.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 
@@ -49,7 +49,7 @@ struct Run {
 /// reduced one).
 struct Setup {
   BuiltScene built;
-  FourWsVehicle* car = nullptr;  // built's vehicle
+  WheeledVehicle* car = nullptr;  // built's vehicle
   SimTK::State initial;
 };
 
@@ -62,9 +62,9 @@ Setup makeSetup(const study::Ch3Case& ch3, const std::string& model) {
     st.initial = s0;
   } else {  // "reduced", or "dense": the reduced model with its rows solved densely
     st.built = ch3.build("reduced");
-    st.initial = st.built.vehicleAs<FourWsVehicle>().makeStateLike(con.vehicleAs<FourWsVehicle>(), s0);
+    st.initial = st.built.vehicleAs<WheeledVehicle>().makeStateLike(con.vehicleAs<WheeledVehicle>(), s0);
   }
-  st.car = &st.built.vehicleAs<FourWsVehicle>();
+  st.car = &st.built.vehicleAs<WheeledVehicle>();
   if (model == "dense") st.car->useDenseRows(st.initial);
   st.car->getScene().getSystem().realize(st.initial, SimTK::Stage::Velocity);
   return st;
@@ -136,7 +136,7 @@ int main(int argc, char** argv) {
     opts.add_options()("data", po::value<std::string>()->default_value("scenes/ch3_transient.json"), "scene file of the manoeuvre")(
         "models", po::value<std::string>()->default_value("constrained,reduced,dense"),
         "comma-separated models: constrained, reduced (rows solved by Simbody), dense (the reduced model's rows "
-        "solved densely, FourWsVehicle::useDenseRows)")(
+        "solved densely, WheeledVehicle::useDenseRows)")(
         "integrators", po::value<std::string>()->default_value("rk_merson,rk3,rk_feldberg,cpodes"),
         "comma-separated integrator names")(
         "accuracies", po::value<std::string>()->default_value("1e-3,1e-4,1e-5,1e-6,1e-7,1e-8"), "comma-separated accuracies")(

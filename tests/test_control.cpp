@@ -12,7 +12,7 @@
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/vehicles/bicycle.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 using SimTK::Vec2;
@@ -251,12 +251,12 @@ namespace {
 /// error delta_r - Kr delta_f against the closed form of (8.5):
 /// e'' + G2 e' + G1 e = 0 from e(0) = e0, e'(0) = 0.
 double rearTrackingMismatch(const std::shared_ptr<const RearSteerStrategy>& strategy, double& kr) {
-  FourWsVehicle car(FourWsParams::fromFile("appendix_a.json"));
-  car.addAxleSteering("front_steer", true, SteeringStateSpec{});
+  WheeledVehicle car(WheeledVehicleParams::fromFile("appendix_a.json"));
+  car.addAxleSteering("front_steer", "front", SteeringStateSpec{});
   SteeringStateSpec rearStart;
   const double e0 = 0.01;
   rearStart.initial_angle_rad = e0;
-  car.addAxleSteering("rear_steer", false, rearStart);
+  car.addAxleSteering("rear_steer", "rear", rearStart);
   const LaneChangeParams lp{5.0, 0.0, 40.0, 2.0};
   Scene& sc = car.updScene();
   sc.addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis",

@@ -32,6 +32,7 @@
 #include "vdyn/steering_ratio/linear_ratio.h"
 #include "vdyn/tire/tire_model.h"
 #include "vdyn/vehicles/standard_registry.h"
+#include "vdyn/vehicles/suspension.h"
 
 using namespace vdyn;
 using vdyn::test::errorOf;
@@ -166,7 +167,8 @@ void checkType(const std::string& what, const std::vector<FieldInfo>& fields,
 /// The data file each vehicle type is checked with (its geometry must be real).
 const std::map<std::string, std::string>& vehicleData() {
   static const std::map<std::string, std::string> m = {
-      {"fourws", "appendix_a.json"}, {"bicycle", "bicycle.json"}, {"quarter_car", "quarter_car.json"}};
+      {"fourws", "appendix_a.json"}, {"wheeled", "appendix_a.json"}, {"bicycle", "bicycle.json"},
+      {"quarter_car", "quarter_car.json"}};
   return m;
 }
 
@@ -199,7 +201,8 @@ TEST(RegistryKeys, EveryChoiceAcceptsExactlyItsListedKeys) {
   const PluginRegistry& reg = standardRegistry();
   const KrTable table = KrTable::fromFile(resolveDataPath("kr_table.json"));
   const std::vector<std::string> families = reg.choiceFamilies();
-  EXPECT_EQ(families, (std::vector<std::string>{"rear_steer_strategy", "sensitivity_method", "steering_command"}))
+  EXPECT_EQ(families, (std::vector<std::string>{"rear_steer_strategy", "sensitivity_method", "steering_command",
+                                                "suspension_template"}))
       << "a new choice family: add its Base and Context to this test";
   for (const auto& family : families)
     for (const auto& type : reg.knownChoices(family)) {
@@ -214,6 +217,8 @@ TEST(RegistryKeys, EveryChoiceAcceptsExactlyItsListedKeys) {
                                                                 RearSteerContext{LinearBicycleParams{}, &table}, "t.json");
         else if (family == "sensitivity_method")
           reg.createChoice<SensitivityMethod, SensitivitySettings>(family, type, r, SensitivitySettings{}, "t.json");
+        else if (family == "suspension_template")
+          reg.createChoice<Suspension>(family, type, r, NoContext{}, "t.json");
       });
     }
 }
@@ -246,11 +251,16 @@ TEST(RegistryKeys, EveryVehicleReadsExactlyItsListedDataKeys) {
   }
 }
 
-TEST(RegistryKeys, FourWsListsCornerModelAndForwardDynamics) {
-  const TypeInfo& info = standardRegistry().info(PluginKind::Vehicle, "fourws");
+TEST(RegistryKeys, WheeledListsItsTemplatesAndForwardDynamics) {
+  const TypeInfo& info = standardRegistry().info(PluginKind::Vehicle, "wheeled");
   std::map<std::string, std::string> defaults;
   for (const auto& f : info.fields) defaults[f.key] = f.default_value;
-  EXPECT_EQ(defaults["data: corner_model"], "\"constrained\"");
+  EXPECT_EQ(defaults["data: axles"], "required");
+  for (const char* t : {"double_wishbone", "double_wishbone_reduced"}) {
+    std::set<std::string> keys;
+    for (const auto& f : standardRegistry().choiceInfo("suspension_template", t).fields) keys.insert(f.key);
+    EXPECT_EQ(keys, (std::set<std::string>{"bodies", "joints", "spring", "left"})) << t;
+  }
   EXPECT_EQ(defaults["data: forward_dynamics"], "\"simbody\"");
   EXPECT_EQ(defaults["data: gravity_m_per_s2"], "9.81");
 }

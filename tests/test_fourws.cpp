@@ -6,16 +6,16 @@
 
 #include "vdyn/core/simulation.h"
 #include "vdyn/speed/speed_hold.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 
 namespace {
-FourWsParams appendixA() { return FourWsParams::fromFile("appendix_a.json"); }
+WheeledVehicleParams appendixA() { return WheeledVehicleParams::fromFile("appendix_a.json"); }
 }  // namespace
 
 TEST(FourWs, ModelSizeWithoutSteering) {
-  const FourWsVehicle car(appendixA());
+  const WheeledVehicle car(appendixA());
   const SimTK::State s = car.makeInitialState();
   // Joint coordinates (seed 3.2): chassis 6 + 4 x (lower arm 1 + knuckle 3 + upper
   // arm 1 + spin 1) = 30 mobilities; 12 loop-closure equations. The four steering
@@ -26,13 +26,13 @@ TEST(FourWs, ModelSizeWithoutSteering) {
 }
 
 TEST(FourWs, TotalMassIsTableA1) {
-  const FourWsVehicle car(appendixA());
+  const WheeledVehicle car(appendixA());
   // 800 + 2 (0.5 + 5 + 0.5 + 20) + 2 (0.5 + 5 + 0.5 + 30) = 924 kg (docs/vehicle_data.md).
   EXPECT_DOUBLE_EQ(car.totalMass(), 924.0);
 }
 
 TEST(FourWs, AssemblyClosesAllFourLoops) {
-  const FourWsVehicle car(appendixA());
+  const WheeledVehicle car(appendixA());
   AssemblyReport rep;
   const SimTK::State s = car.makeInitialState(0.0, &rep);
   EXPECT_NEAR(rep.initial_loop_gap_m, 0.040, 0.002);  // the front loops, as printed
@@ -45,7 +45,7 @@ TEST(FourWs, AssemblyClosesAllFourLoops) {
 }
 
 TEST(FourWs, LeftSideMirrorsRightAfterAssembly) {
-  const FourWsVehicle car(appendixA());
+  const WheeledVehicle car(appendixA());
   const SimTK::State s = car.makeInitialState();
   for (int right : {RF, RR}) {
     const int left = right + 1;
@@ -54,35 +54,35 @@ TEST(FourWs, LeftSideMirrorsRightAfterAssembly) {
         {car.corner(left).lower_arm, car.corner(left).knuckle, car.corner(left).upper_arm, car.corner(left).wheel}};
     for (int b = 0; b < 4; ++b) {
       const SimTK::Vec3 pr = bodies[0][b].getBodyOriginLocation(s), pl = bodies[1][b].getBodyOriginLocation(s);
-      EXPECT_NEAR(pr[0], pl[0], 1e-9) << cornerName(right) << " body " << b;
-      EXPECT_NEAR(pr[1], -pl[1], 1e-9) << cornerName(right) << " body " << b;
-      EXPECT_NEAR(pr[2], pl[2], 1e-9) << cornerName(right) << " body " << b;
+      EXPECT_NEAR(pr[0], pl[0], 1e-9) << car.cornerName(right) << " body " << b;
+      EXPECT_NEAR(pr[1], -pl[1], 1e-9) << car.cornerName(right) << " body " << b;
+      EXPECT_NEAR(pr[2], pl[2], 1e-9) << car.cornerName(right) << " body " << b;
     }
   }
 }
 
 TEST(FourWs, InitialSpeedRollsTheWheels) {
-  const FourWsVehicle car(appendixA());
+  const WheeledVehicle car(appendixA());
   const SimTK::State s = car.makeInitialState(10.0);
   const Scene& sc = car.getScene();
   EXPECT_NEAR(sc.evalOutput("chassis.forward_speed_m_s", s), 10.0, 1e-12);
   EXPECT_NEAR(sc.evalOutput("chassis.side_slip_rad", s), 0.0, 1e-12);
   for (int c = 0; c < 4; ++c) {
     const TireContact k = car.tire(c).calcContact(s);
-    ASSERT_TRUE(k.in_contact) << cornerName(c);
+    ASSERT_TRUE(k.in_contact) << car.cornerName(c);
     // Free rolling: no longitudinal slip velocity, so no longitudinal force.
-    EXPECT_NEAR(k.forces.slip_ratio, 0.0, 1e-9) << cornerName(c);
+    EXPECT_NEAR(k.forces.slip_ratio, 0.0, 1e-9) << car.cornerName(c);
   }
 }
 
 TEST(FourWs, UnknownTirePluginListsKnownOnes) {
-  FourWsParams p = appendixA();
-  p.tire.plugin = "magic";
+  WheeledVehicleParams p = appendixA();
+  p.axles[0].tire.plugin = "magic";
   try {
-    FourWsVehicle car(p);
+    WheeledVehicle car(p);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "4ws tire plugin: unknown force element plugin 'magic'; known: body_force, fiala, gim, linear, magic_formula");
+    EXPECT_STREQ(e.what(), "appendix_a.json: tire.plugin: unknown force element plugin 'magic'; known: body_force, fiala, gim, linear, magic_formula");
   }
 }
 
@@ -92,7 +92,7 @@ namespace {
 /// The 4WS vehicle with front and rear steering commands, run to t_end at
 /// 10 m/s; records the chassis and steering outputs every 10 ms.
 struct SteeredRun {
-  std::unique_ptr<FourWsVehicle> car;
+  std::unique_ptr<WheeledVehicle> car;
   std::unique_ptr<Recorder> rec;
   RunSummary run;
   SimTK::State final;
@@ -101,9 +101,9 @@ struct SteeredRun {
 SteeredRun runSteered(std::shared_ptr<const SteeringCommand> front, std::shared_ptr<const SteeringCommand> rear,
                       double tEnd) {
   SteeredRun r;
-  r.car = std::make_unique<FourWsVehicle>(appendixA());
-  r.car->addAxleSteering("front_steer", true, std::move(front));
-  r.car->addAxleSteering("rear_steer", false, std::move(rear));
+  r.car = std::make_unique<WheeledVehicle>(appendixA());
+  r.car->addAxleSteering("front_steer", "front", std::move(front));
+  r.car->addAxleSteering("rear_steer", "rear", std::move(rear));
   r.final = r.car->makeInitialState(10.0);
   r.rec = std::make_unique<Recorder>(
       r.car->getScene(), std::vector<std::string>{"chassis.y_m", "chassis.yaw_rate_rad_s", "front_steer.angle_rad",
@@ -126,9 +126,9 @@ double maxAbsDiff(const std::vector<double>& a, const std::vector<double>& b) {
 }  // namespace
 
 TEST(FourWsSteering, FourteenDegreesOfFreedom) {
-  FourWsVehicle car(appendixA());
-  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.0));
-  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.0));
+  WheeledVehicle car(appendixA());
+  car.addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(0.0));
+  car.addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(0.0));
   const SimTK::State s = car.makeInitialState(10.0);
   EXPECT_EQ(s.getNUDotErr(), 16);  // 12 loop closure + 4 steering (App. A)
   EXPECT_EQ(car.degreesOfFreedom(s), 14);
@@ -193,10 +193,10 @@ TEST(FourWsSteering, CommandErrorsAreNamed) {
 // --- speed hold (3.18) --------------------------------------------------------
 
 TEST(FourWsSpeedHold, HoldsTheSpeedThroughATurnAndReportsItsForce) {
-  FourWsVehicle car(appendixA());
+  WheeledVehicle car(appendixA());
   const double d = 4.0 * SimTK::Pi / 180;
-  car.addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, d, 0.2, 0.5));
-  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.0));
+  car.addAxleSteering("front_steer", "front", std::make_shared<SmoothStepCommand>(0, d, 0.2, 0.5));
+  car.addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(0.0));
   car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
   SimTK::State s = car.makeInitialState(10.0);
   EXPECT_EQ(car.degreesOfFreedom(s), 13);  // 14 less the speed condition

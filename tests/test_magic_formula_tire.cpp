@@ -12,7 +12,7 @@
 #include "vdyn/core/scene_file.h"
 #include "vdyn/magic_formula/magic_formula_tire.h"
 #include "vdyn/tire/tire_force.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
@@ -130,8 +130,8 @@ TEST(MagicFormulaTire, UnknownFileAndKeysAreNamed) {
 // held straight: once settled (2 s to 10 s) it creeps sideways by less than
 // 1 mm/s. (The wheels are not braked: along x the car is free to roll.)
 TEST(MagicFormulaTire, AtRestPushedSidewaysItCreepsUnderOneMillimetrePerSecond) {
-  const FourWsParams data = FourWsParams::fromFile("appendix_a_mf.json");
-  const FourWsVehicle car(data);
+  const WheeledVehicleParams data = WheeledVehicleParams::fromFile("appendix_a_mf.json");
+  const WheeledVehicle car(data);
   const double weight = car.totalMass() * data.gravity_m_per_s2;
   Json scene = R"({"name": "creep", "vehicle": {"type": "fourws", "data": "appendix_a_mf.json", "initial_speed_m_s": 0},
     "plugins": [

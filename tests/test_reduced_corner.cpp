@@ -15,28 +15,28 @@
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/speed/speed_hold.h"
 #include "vdyn/steady_state/steady_state.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 
 namespace {
 const double kDeg = SimTK::Pi / 180;
 
-FourWsParams params(const std::string& model, const std::string& file = "appendix_a.json") {
-  FourWsParams p = FourWsParams::fromFile(file);
-  p.corner_model = model;
+WheeledVehicleParams params(const std::string& model, const std::string& file = "appendix_a.json") {
+  WheeledVehicleParams p = WheeledVehicleParams::fromFile(file);
+  p.setSuspensionTemplate(model == "reduced" ? "double_wishbone_reduced" : "double_wishbone");
   return p;
 }
 
 /// The chapter 3 manoeuvre: smooth steps 4 deg front, 1 deg rear from 0.5 s over 1 s, 10 m/s.
-std::unique_ptr<FourWsVehicle> ch3Car(const std::string& model, const std::string& file, bool hold) {
-  auto car = std::make_unique<FourWsVehicle>(params(model, file));
+std::unique_ptr<WheeledVehicle> ch3Car(const std::string& model, const std::string& file, bool hold) {
+  auto car = std::make_unique<WheeledVehicle>(params(model, file));
   if (hold) {
-    car->addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(4 * kDeg));
-    car->addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(1 * kDeg));
+    car->addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(4 * kDeg));
+    car->addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(1 * kDeg));
   } else {
-    car->addAxleSteering("front_steer", true, std::make_shared<SmoothStepCommand>(0, 4 * kDeg, 0.5, 1.0));
-    car->addAxleSteering("rear_steer", false, std::make_shared<SmoothStepCommand>(0, 1 * kDeg, 0.5, 1.0));
+    car->addAxleSteering("front_steer", "front", std::make_shared<SmoothStepCommand>(0, 4 * kDeg, 0.5, 1.0));
+    car->addAxleSteering("rear_steer", "rear", std::make_shared<SmoothStepCommand>(0, 1 * kDeg, 0.5, 1.0));
   }
   car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
   return car;
@@ -44,6 +44,7 @@ std::unique_ptr<FourWsVehicle> ch3Car(const std::string& model, const std::strin
 
 /// The two corner models compared throughout.
 const char* const kModels[2] = {"constrained", "reduced"};
+const char* const kTemplates[2] = {"double_wishbone", "double_wishbone_reduced"};
 
 double vee(const SimTK::Mat33& W, int i) {
   return i == 0 ? 0.5 * (W(2, 1) - W(1, 2)) : i == 1 ? 0.5 * (W(0, 2) - W(2, 0)) : 0.5 * (W(1, 0) - W(0, 1));
@@ -83,7 +84,7 @@ void expectSameCh3Transient(const Scene& a, SimTK::State& sa, const Scene& b, Si
 }  // namespace
 
 TEST(ReducedCorner, ModelSizeAndDegreesOfFreedom) {
-  const FourWsVehicle car(params("reduced"));
+  const WheeledVehicle car(params("reduced"));
   const SimTK::State s = car.makeInitialState();
   // chassis 6 + 4 x (lower arm 1 + knuckle 2 + upper arm 1 + spin 1) = 26
   // mobilities; 2 arm rows per corner; the same 18 degrees of freedom.
@@ -94,16 +95,18 @@ TEST(ReducedCorner, ModelSizeAndDegreesOfFreedom) {
   EXPECT_THROW(car.corner(RF), Error);
 }
 
-TEST(ReducedCorner, UnknownCornerModelIsNamed) {
-  FourWsParams p = params("constrained");
-  p.corner_model = "rigid";
-  const std::string e = vdyn::test::errorOf([&] { p.validate(); });
-  EXPECT_NE(e.find("corner_model"), std::string::npos) << e;
-  EXPECT_NE(e.find("rigid"), std::string::npos) << e;
+TEST(ReducedCorner, UnknownSuspensionTemplateIsNamed) {
+  WheeledVehicleParams p = params("constrained");
+  p.setSuspensionTemplate("rigid");
+  const std::string e = vdyn::test::errorOf([&] { WheeledVehicle car(p); });
+  EXPECT_NE(e.find("appendix_a.json: axles.front.suspension: template: unknown suspension template 'rigid'"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("double_wishbone_reduced"), std::string::npos) << e;  // the known ones listed
 }
 
 TEST(ReducedCorner, LoopClosureAndSteeringAngleExactByConstruction) {
-  const FourWsVehicle car(params("reduced"));
+  const WheeledVehicle car(params("reduced"));
   SimTK::State s = car.makeInitialState();
   for (int c = 0; c < 4; ++c) {
     const DoubleWishboneParams& p = car.cornerParams(c);
@@ -118,8 +121,8 @@ TEST(ReducedCorner, LoopClosureAndSteeringAngleExactByConstruction) {
                                      rc.knuckle.findStationLocationInGround(s, p.lower_ball.child_point_m);
         const SimTK::Vec3 upperGap = rc.upper_arm.findStationLocationInGround(s, p.upper_ball.parent_point_m) -
                                      rc.knuckle.findStationLocationInGround(s, p.upper_ball.child_point_m);
-        EXPECT_LT(lowerGap.norm(), 1e-14) << cornerName(c) << " s " << sq << " delta " << delta;
-        EXPECT_LT(upperGap.norm(), 1e-14) << cornerName(c) << " s " << sq << " delta " << delta;
+        EXPECT_LT(lowerGap.norm(), 1e-14) << car.cornerName(c) << " s " << sq << " delta " << delta;
+        EXPECT_LT(upperGap.norm(), 1e-14) << car.cornerName(c) << " s " << sq << " delta " << delta;
         // (A.1): the steering angle equals the coordinate.
         EXPECT_NEAR(steeringAngle(s, car.chassis(), rc.knuckle, SimTK::UnitVec3(p.wheel_spin_axis)), delta, 1e-14);
         EXPECT_LT(positionConstraintError(s), 1e-14);  // the arm rows
@@ -128,8 +131,9 @@ TEST(ReducedCorner, LoopClosureAndSteeringAngleExactByConstruction) {
 }
 
 TEST(ReducedCorner, MobilizerDerivativesMatchFiniteDifferences) {
-  const FourWsParams p = params("reduced");
-  for (const DoubleWishboneParams& cp : {p.front_right, p.rear_right.mirrored()}) {
+  const WheeledVehicleParams p = params("reduced");
+  const WheeledVehicle car(p);
+  for (const DoubleWishboneParams& cp : {car.cornerParams(RF), car.cornerParams(LR)}) {
     const WishboneLoop loop(cp);
     SimTK::MultibodySystem sys;
     SimTK::SimbodyMatterSubsystem matter(sys);
@@ -168,7 +172,7 @@ TEST(ReducedCorner, MobilizerDerivativesMatchFiniteDifferences) {
 TEST(ReducedCorner, VelocitiesAndAccelerationsMatchFiniteDifferencesOfPositions) {
   // Simbody's own body velocities and bias accelerations of the knuckle (from
   // H and HDot) against differences of its positions along a motion.
-  const FourWsVehicle car(params("reduced"));
+  const WheeledVehicle car(params("reduced"));
   const SimTK::MultibodySystem& sys = car.getScene().getSystem();
   const ReducedWishboneCorner& rc = car.reducedCorner(LF);
   SimTK::State s = car.makeInitialState();
@@ -216,7 +220,7 @@ TEST(ReducedCorner, VelocitiesAndAccelerationsMatchFiniteDifferencesOfPositions)
 
 TEST(ReducedCorner, SameCh3SteadyStateAsTheConstrainedModel) {
   SteadyStateResult r[2];
-  std::unique_ptr<FourWsVehicle> cars[2];
+  std::unique_ptr<WheeledVehicle> cars[2];
   for (int m = 0; m < 2; ++m) {
     cars[m] = ch3Car(kModels[m], "appendix_a_relaxation.json", true);
     const Scene& sc = cars[m]->getScene();
@@ -234,7 +238,7 @@ TEST(ReducedCorner, SameCh3SteadyStateAsTheConstrainedModel) {
   EXPECT_NEAR(cars[1]->getScene().evalOutput("speed_hold.force_N", r[1].state),
               cars[0]->getScene().evalOutput("speed_hold.force_N", r[0].state), 1e-5);
   for (int c = 0; c < 4; ++c)
-    EXPECT_NEAR(cars[1]->suspensionAngle(r[1].state, c), cars[0]->suspensionAngle(r[0].state, c), 1e-9) << cornerName(c);
+    EXPECT_NEAR(cars[1]->suspensionAngle(r[1].state, c), cars[0]->suspensionAngle(r[0].state, c), 1e-9) << cars[0]->cornerName(c);
 }
 
 TEST(ReducedCorner, SameCh3TransientAsTheConstrainedModel) {
@@ -243,7 +247,7 @@ TEST(ReducedCorner, SameCh3TransientAsTheConstrainedModel) {
   SimTK::State sc = con->makeInitialState(10.0);
   SimTK::State sr = red->makeInitialState(10.0);
   // Both start in the constrained model's assembled configuration.
-  for (int c = 0; c < 4; ++c) EXPECT_NEAR(red->suspensionAngle(sr, c), con->suspensionAngle(sc, c), 1e-12) << cornerName(c);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(red->suspensionAngle(sr, c), con->suspensionAngle(sc, c), 1e-12) << con->cornerName(c);
   const SimTK::State mapped = red->makeStateLike(*con, sc);
   EXPECT_LT((mapped.getQ() - sr.getQ()).normInf(), 1e-12);
   expectSameCh3Transient(con->getScene(), sc, red->getScene(), sr);
@@ -258,7 +262,8 @@ TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
     SensitivityProblem p;
     p.model = SceneDesign::fromAnalysis(SceneDescription::fromFile(
         "scenes/ch4_sensitivity_fourws.json", standardRegistry(),
-        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.corner_model", kModels[m]}}));
+        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.axles.front.suspension.template", kTemplates[m]},
+         {"vehicle.overrides.axles.rear.suspension.template", kTemplates[m]}}));
     p.parameters = {"front.spring.stiffness_N_per_m"};
     p.cost = CostFunctional::parse("integral_of_square:chassis.roll_rate_rad_s");
     p.t_end_s = 1.0;
@@ -310,19 +315,19 @@ TEST(ReducedDense, SameCh3TransientAsSimbodysRows) {
 }
 
 TEST(ReducedDense, NeedsTheReducedModelAndTimeCommands) {
-  FourWsParams p = params("constrained");
+  WheeledVehicleParams p = params("constrained");
   p.forward_dynamics = "dense";
   EXPECT_THROW(p.validate(), Error);
   const auto con = ch3Car("constrained", "appendix_a.json", true);
   SimTK::State s = con->makeInitialState(10.0);
   EXPECT_THROW(con->useDenseRows(s), Error);
   // A state-driven steering plugin is not a time command: named Error.
-  auto red = std::make_unique<FourWsVehicle>(params("reduced"));
+  auto red = std::make_unique<WheeledVehicle>(params("reduced"));
   struct Zero : SteeringLaw {
     Zero() : SteeringLaw("zero") {}
     double DoCalcAcceleration(const SimTK::State&) const override { return 0; }
   };
-  red->addAxleSteering("front_steer", true, SteeringStateSpec{}).setAccelerationLaw(std::make_shared<Zero>());
+  red->addAxleSteering("front_steer", "front", SteeringStateSpec{}).setAccelerationLaw(std::make_shared<Zero>());
   SimTK::State sr = red->getScene().getDefaultState();
   try {
     red->useDenseRows(sr);

@@ -17,7 +17,7 @@
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/sensitivity/sensitivity.h"
 #include "vdyn/steering/steering.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/quarter_car.h"
 #include "vdyn/vehicles/standard_registry.h"
 
@@ -218,7 +218,7 @@ TEST(SceneDesign, ParameterWithAnIndexIsReadAndSet) {
 
 TEST(Registry, EveryKindIsRegisteredAndDocumented) {
   const PluginRegistry& r = standardRegistry();
-  EXPECT_EQ(r.known(PluginKind::Vehicle), (std::vector<std::string>{"bicycle", "fourws", "quarter_car"}));
+  EXPECT_EQ(r.known(PluginKind::Vehicle), (std::vector<std::string>{"bicycle", "fourws", "quarter_car", "wheeled"}));
   EXPECT_TRUE(r.has(PluginKind::ForceElement, "gim"));
   EXPECT_TRUE(r.has(PluginKind::Constraint, "steering"));
   EXPECT_TRUE(r.has(PluginKind::Constraint, "speed_hold"));
@@ -283,13 +283,13 @@ TEST(SceneFile, BuildThrowsTheFirstErrorNamingFileAndKey) {
 }
 
 // The scene path composes the same Simbody system as the C++ builders: the
-// final state of a scene run equals, bit for bit, that of FourWsVehicle with
+// final state of a scene run equals, bit for bit, that of WheeledVehicle with
 // addAxleSteering and SpeedHoldPlugin added by hand in the same order.
 TEST(SceneFile, TransientEqualsTheSameCompositionInCxxBitForBit) {
   const SceneDescription s = smallScene();
   const Json summary = runScene(s);
-  FourWsVehicle car(FourWsParams::fromFile("appendix_a.json"));
-  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.05));
+  WheeledVehicle car(WheeledVehicleParams::fromFile("appendix_a.json"));
+  car.addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(0.05));
   car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
   SimTK::State st = car.makeInitialState(10.0);
   SimulationSettings sim;
@@ -409,7 +409,7 @@ TEST(Registry, ChoicesAreRegisteredNamesThatPluginsOfASceneFind) {
 // The concrete vehicle of a built scene, for code that needs its own API.
 TEST(SceneFile, VehicleAsGivesTheConcreteVehicleOrANamedError) {
   BuiltScene b = smallScene().build();
-  EXPECT_EQ(&b.vehicleAs<FourWsVehicle>().getScene(), &b.scene());
+  EXPECT_EQ(&b.vehicleAs<WheeledVehicle>().getScene(), &b.scene());
   EXPECT_EQ(errorOf([&] { b.vehicleAs<QuarterCar>(); }), "vehicle 'fourws' is not a vdyn::QuarterCar");
 }
 
@@ -505,25 +505,26 @@ TEST(SceneAnalyses, ContinuationAgreesWithSteadyState) {
   EXPECT_EQ(co["points"][1]["value"].get<double>(), 12.0);
 }
 
-// A reduced 4WS vehicle built from a scene file (corner_model "reduced" as a
-// vehicle override, steering plugins from the registry) starts from the same
-// state as the same composition in C++ (FourWsVehicle::addAxleSteering): the
+// A reduced 4WS vehicle built from a scene file (double_wishbone_reduced as
+// vehicle overrides, steering plugins from the registry) starts from the same
+// state as the same composition in C++ (WheeledVehicle::addAxleSteering): the
 // constrained copy it is assembled from carries the scene's steering holds
 // (front 0.05 rad, rear 0.02 rad), so positions and speeds agree bit for bit.
 TEST(SceneFile, ReducedFourWsStartsLikeTheCxxCompositionWithItsSteeringHolds) {
-  Json extra = R"({"vehicle": {"overrides": {"corner_model": "reduced"}}})"_json;
+  Json extra = R"({"vehicle": {"overrides": {"axles": {"front": {"suspension": {"template": "double_wishbone_reduced"}},
+                                                      "rear": {"suspension": {"template": "double_wishbone_reduced"}}}}}})"_json;
   Json j = smallScene(extra).json();
   j["plugins"].insert(j["plugins"].begin() + 1, R"({"type": "steering", "name": "rear_steer", "attach": "rear_axle",
                                                     "command": {"type": "hold", "angle_rad": 0.02}})"_json);
   const BuiltScene built = SceneDescription::fromJson(j, "small.json", standardRegistry()).build();
-  ASSERT_TRUE(built.vehicleAs<FourWsVehicle>().isReduced());
+  ASSERT_TRUE(built.vehicleAs<WheeledVehicle>().isReduced());
   const SimTK::State ss = built.makeInitialState();
 
-  FourWsParams p = FourWsParams::fromFile("appendix_a.json");
-  p.corner_model = "reduced";
-  FourWsVehicle car(p);
-  car.addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(0.05));
-  car.addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(0.02));
+  WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a.json");
+  p.setSuspensionTemplate("double_wishbone_reduced");
+  WheeledVehicle car(p);
+  car.addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(0.05));
+  car.addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(0.02));
   car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
   const SimTK::State cs = car.makeInitialState(10.0);
 

@@ -14,7 +14,7 @@
 #include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/linear_ratio.h"
 #include "vdyn/vehicles/bicycle.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 using vdyn::test::errorOf;
@@ -195,9 +195,9 @@ TEST(SteadyState, ProblemErrorsAreNamed) {
 // the steady slips (zdot = 0 is one of the solved equations).
 TEST(SteadyState, RelaxationTireLeavesTheSteadyTurnUnchanged) {
   auto solveWith = [](const std::string& file, SteadyStateResult& out) {
-    auto car = std::make_unique<FourWsVehicle>(FourWsParams::fromFile(file));
-    car->addAxleSteering("front_steer", true, std::make_shared<HoldCommand>(4.0 * kDeg));
-    car->addAxleSteering("rear_steer", false, std::make_shared<HoldCommand>(1.0 * kDeg));
+    auto car = std::make_unique<WheeledVehicle>(WheeledVehicleParams::fromFile(file));
+    car->addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(4.0 * kDeg));
+    car->addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(1.0 * kDeg));
     car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
     const Scene& sc = car->getScene();
     SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));

@@ -14,7 +14,7 @@
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/steering_ratio.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 using vdyn::test::errorOf;
@@ -113,7 +113,7 @@ TEST(SteeringRatio, ErrorsNameTheFieldAndValue) {
 namespace {
 /// The App. A vehicle with linear tires, front and rear held, speed held.
 struct LinearFourWs {
-  std::unique_ptr<FourWsVehicle> car;
+  std::unique_ptr<WheeledVehicle> car;
   std::shared_ptr<HoldCommand> front = std::make_shared<HoldCommand>(0.0);
   std::shared_ptr<HoldCommand> rear = std::make_shared<HoldCommand>(0.0);
   std::unique_ptr<SteadyStateSolver> solver;
@@ -121,11 +121,11 @@ struct LinearFourWs {
   LinearBicycleParams lin;  // the vehicle's own linear bicycle
 
   explicit LinearFourWs(double U) {
-    FourWsParams p = FourWsParams::fromFile("appendix_a.json");
-    p.tire = p.tire.linearised();
-    car = std::make_unique<FourWsVehicle>(p);
-    car->addAxleSteering("front_steer", true, front);
-    car->addAxleSteering("rear_steer", false, rear);
+    WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a.json");
+    for (AxleParams& a : p.axles) a.tire = a.tire.linearised();
+    car = std::make_unique<WheeledVehicle>(p);
+    car->addAxleSteering("front_steer", "front", front);
+    car->addAxleSteering("rear_steer", "rear", rear);
     const auto& hold = static_cast<const SpeedHoldPlugin&>(
         car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U)));
     const Scene& sc = car->getScene();
@@ -142,7 +142,7 @@ struct LinearFourWs {
     lin.front_axle_to_com_m = 0.5 * (wheelX(RF) + wheelX(LF)) - com[0];
     lin.rear_axle_to_com_m = com[0] - 0.5 * (wheelX(RR) + wheelX(LR));
     lin.front_cornering_stiffness_N_per_rad = lin.rear_cornering_stiffness_N_per_rad =
-        2 * p.tire.getNumber("cornering_stiffness_N_per_rad");
+        2 * p.axles[0].tire.getNumber("cornering_stiffness_N_per_rad");
   }
   SetSteering steer() {
     return [this](SimTK::State&, double f, double r) {
@@ -228,11 +228,11 @@ TEST(SteeringRatio, GimTireBranchEndsWithAdmissiblePointsOnly) {
   // slip (or is flagged), is stable where checked, and the end is located
   // between two front angles by bisection (inserted points ascend).
   const double U = 25.0;
-  FourWsParams p = FourWsParams::fromFile("appendix_a.json");
-  FourWsVehicle car(p);
+  WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a.json");
+  WheeledVehicle car(p);
   auto front = std::make_shared<HoldCommand>(0.0), rear = std::make_shared<HoldCommand>(0.0);
-  car.addAxleSteering("front_steer", true, front);
-  car.addAxleSteering("rear_steer", false, rear);
+  car.addAxleSteering("front_steer", "front", front);
+  car.addAxleSteering("rear_steer", "rear", rear);
   const auto& hold = static_cast<const SpeedHoldPlugin&>(
       car.updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", U)));
   const Scene& sc = car.getScene();

@@ -62,6 +62,9 @@ int main(int argc, char** argv) {
     const int dof = tr.vehicle.at("dof").get<int>();
     const double totalMass = tr.vehicle.at("total_mass_kg").get<double>();
     const double assemblyMove = tr.vehicle.at("assembly_max_body_move_m").get<double>();
+    // "reduced" when the App. A axles are double_wishbone_reduced, else "constrained".
+    const std::string cornerModel =
+        tr.vehicle.at("suspensions").value("front", "") == "double_wishbone_reduced" ? "reduced" : "constrained";
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
     const double steadyWindow = 2.0, steadyRel = 1e-3, steadyAbs = 1e-5;
@@ -110,7 +113,7 @@ int main(int argc, char** argv) {
                     {"real_time_factor", run.sim_time_s / run.wall_time_s},
                     {"steps", run.steps},
                     {"evaluations", run.realizations},
-                    {"corner_model", tr.vehicle.at("corner_model")},
+                    {"corner_model", cornerModel},
                     {"integrator", run.integrator},
                     {"accuracy", run.accuracy},
                     {"assembly_max_body_move_m", assemblyMove}};
@@ -144,7 +147,7 @@ int main(int argc, char** argv) {
     std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, max |steer - command| %.2e rad, %d steps, "
                 "%d evaluations (%s corners)\n",
                 dof, totalMass, run.max_constraint_error, steerError, run.steps, run.realizations,
-                tr.vehicle.at("corner_model").get<std::string>().c_str());
+                cornerModel.c_str());
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
     if (!verdict.steady)

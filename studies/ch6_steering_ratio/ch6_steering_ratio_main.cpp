@@ -30,7 +30,7 @@
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/steering_ratio.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 
@@ -166,7 +166,7 @@ int main(int argc, char** argv) {
                 linearKr["25"].get<double>(), zeroSpeed);
 
     // --- Figure 6.4: nonlinear map, one thread per speed -------------------------
-    const FourWsParams params = FourWsParams::fromFile(vm["data"].as<std::string>());
+    const WheeledVehicleParams params = WheeledVehicleParams::fromFile(vm["data"].as<std::string>());
     // Validated here with the option names; the values go to the scene's
     // optimal_ratio analysis (one code path with `vdyn run`).
     const int maxIterations = vm["max-newton-iterations"].as<int>();
@@ -239,7 +239,7 @@ int main(int argc, char** argv) {
           // minPoints angles (high speed); else the base grid.
           std::vector<double> grid = frontsDeg;
           {
-            const double ay = params.tire.getNumber("mu_max") * params.gravity_m_per_s2, klin = calcLinearOptimalRatio(lin, U);
+            const double ay = params.axles[0].tire.getNumber("mu_max") * params.gravity_m_per_s2, klin = calcLinearOptimalRatio(lin, U);
             const double lim = ay * (lin.wheelbase_m() + lin.understeerGradient() * U * U) / (U * U * (1 - klin)) / kDeg;
             if (klin < 1 && lim > 0 && 0.8 * lim < fmin + (minPoints - 1) * fstep) {
               const double step = std::max(0.05, std::floor((0.8 * lim - fmin) / (minPoints - 1) / 0.05) * 0.05);

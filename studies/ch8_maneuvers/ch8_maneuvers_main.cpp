@@ -27,7 +27,7 @@
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/rear_steer/rear_steer.h"
 #include "vdyn/speed/speed_hold.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 
@@ -197,7 +197,7 @@ int main(int argc, char** argv) {
       for (const auto& lib : vm["plugin"].as<std::vector<std::string>>()) loadPluginLibrary(lib, registry);
     const ParamReader data = ParamReader::fromFile(vm["data"].as<std::string>());
     const std::string vehicleData = resolveDataPath(data.string("vehicle_data"));
-    FourWsParams::fromFile(vehicleData);  // a bad vehicle file is an error before any run
+    WheeledVehicleParams::fromFile(vehicleData);  // a bad vehicle file is an error before any run
     const std::string tablePath = vm.count("kr-table") ? vm["kr-table"].as<std::string>() : data.string("kr_table");
     const KrTable table = KrTable::fromFile(tablePath);
     const LinearBicycleParams linear = LinearBicycleParams::fromParams(data.child("linear_bicycle"));

@@ -13,7 +13,7 @@
 #include "study.h"
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/core/scene_file.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 namespace vdyn::study {
@@ -25,7 +25,8 @@ struct Ch3Case {
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
   TransientSettings transient{};     ///< the scene's "analysis" (a transient)
   SimulationSettings sim{};          ///< transient.simulation()
-  /// "constrained" or "reduced" overrides the vehicle file's corner_model; empty keeps it.
+  /// "constrained" or "reduced" sets both App. A axles' suspension template
+  /// (double_wishbone, double_wishbone_reduced); empty keeps the vehicle file's.
   std::string corner_model{};
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
@@ -37,7 +38,7 @@ struct Ch3Case {
         "t-end-s", po::value<double>(), tEndHelp.c_str())(
         "corner-model", po::value<std::string>(),
         "constrained (loops closed by constraints, the reference) or reduced (loops solved in the tree); "
-        "default: the vehicle file's corner_model");
+        "default: the vehicle file's suspension templates");
     addIntegratorOptions(opts);
   }
 
@@ -75,7 +76,7 @@ struct Ch3Case {
     std::string cornerModel;
     if (has("corner-model")) {
       cornerModel = checkedCornerModel(v["corner-model"].as<std::string>());
-      o.push_back({"vehicle.overrides.corner_model", cornerModel});
+      for (const char* key : kTemplateKeys) o.push_back({key, suspensionTemplate(cornerModel)});
     }
     Ch3Case c{SceneDescription::fromFile(sceneFile, standardRegistry(), o)};
     const Json& j = c.scene.json();
@@ -125,11 +126,21 @@ struct Ch3Case {
 
   /// The scene: the vehicle with its steering ("front_steer", "rear_steer")
   /// and speed hold ("speed_hold"), built by the scene loader. `cornerModel`
-  /// (if not empty) overrides corner_model. Code that needs the vehicle's own
-  /// C++ API takes it from the built scene: build().vehicleAs<FourWsVehicle>().
+  /// (if not empty) sets both axles' suspension template. Code that needs the
+  /// vehicle's own C++ API takes it from the built scene:
+  /// build().vehicleAs<WheeledVehicle>().
   BuiltScene build(const std::string& cornerModel = "") const {
     if (cornerModel.empty()) return scene.build();
-    return scene.withOverride("vehicle.overrides.corner_model", checkedCornerModel(cornerModel)).build();
+    const std::string t = suspensionTemplate(checkedCornerModel(cornerModel));
+    return scene.withOverride(kTemplateKeys[0], t).withOverride(kTemplateKeys[1], t).build();
+  }
+
+  /// The scene keys of the two App. A axles' suspension templates.
+  static constexpr const char* kTemplateKeys[2] = {"vehicle.overrides.axles.front.suspension.template",
+                                                   "vehicle.overrides.axles.rear.suspension.template"};
+  /// The template of a corner model: double_wishbone or double_wishbone_reduced.
+  static std::string suspensionTemplate(const std::string& cornerModel) {
+    return cornerModel == "reduced" ? "double_wishbone_reduced" : "double_wishbone";
   }
 
   static std::string checkedCornerModel(const std::string& m) {

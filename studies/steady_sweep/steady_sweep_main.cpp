@@ -16,7 +16,7 @@
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/steady_state/steady_state.h"
 #include "vdyn/steering/steering.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 
 using namespace vdyn;
 

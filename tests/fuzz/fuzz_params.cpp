@@ -16,6 +16,7 @@
 #include "vdyn/tire/road.h"
 #include "vdyn/tire/tire_model.h"
 #include "vdyn/vehicles/double_wishbone.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
@@ -46,11 +47,7 @@ extern "C" int LLVMFuzzerTestOneInput(const uint8_t* data, size_t size) {
     guarded([&] { if (r.has("integrator")) IntegratorSettings::fromParams(r.child("integrator")); });
     guarded([&] { if (r.has("chassis")) RigidBodyParams::fromParams(r.child("chassis")); });
     guarded([&] {
-      if (r.has("front_right")) {
-        const ParamReader c = r.child("front_right");
-        DoubleWishboneParams::fromParams(c);
-        c.requireAllKeysRead();
-      }
+      if (r.has("axles")) WheeledVehicleParams::fromParams(r);
     });
     guarded([&] {
       if (r.has("rows"))

@@ -43,12 +43,18 @@ const FieldTable<BicycleParams>& BicycleParams::fields() {
   static const auto t =
       FieldTable<P>()
           .custom("vehicle_data", "-", "required",
-                  "App. A vehicle data file the axles are lumped from (its chassis, front_right, rear_right, tire)",
+                  "wheeled vehicle data file the axles are lumped from (its chassis, tire and the right corners of "
+                  "its double-wishbone axles front and rear)",
                   [](const ParamReader& r, P& p) {
                     const ParamReader v = ParamReader::fromFile(r.string("vehicle_data"));
                     p.chassis = RigidBodyParams::fromParams(v.child("chassis"));
-                    const DoubleWishboneParams front = DoubleWishboneParams::fromParams(v.child("front_right"));
-                    const DoubleWishboneParams rear = DoubleWishboneParams::fromParams(v.child("rear_right"));
+                    const ParamReader axles = v.child("axles");
+                    auto corner = [&](const char* axle) {
+                      const ParamReader s = axles.child(axle).child("suspension");
+                      s.has("template");  // either double-wishbone formulation: the same mechanism
+                      return DoubleWishboneParams::fromParams(s);
+                    };
+                    const DoubleWishboneParams front = corner("front"), rear = corner("rear");
                     const Vec3 wf = wheelCentreInChassis(front), wr = wheelCentreInChassis(rear);
                     p.front_axle_m = Vec3(wf[0], 0, wf[2]);
                     p.rear_axle_m = Vec3(wr[0], 0, wr[2]);
@@ -63,7 +69,8 @@ const FieldTable<BicycleParams>& BicycleParams::fields() {
                     } else {
                       p.tire = TireChoice::fromParams(v.child("tire"));
                     }
-                    for (const char* k : {"chassis", "front_right", "rear_right"}) v.child(k).requireAllKeysRead();
+                    v.child("chassis").requireAllKeysRead();
+                    for (const char* k : {"front", "rear"}) axles.child(k).child("suspension").requireAllKeysRead();
                   })
           .sample("\"appendix_a.json\"")
           .custom("fork", "-", "required", "rigid body of the steered fork",

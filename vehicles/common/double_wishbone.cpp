@@ -1,5 +1,7 @@
 #include "vdyn/vehicles/double_wishbone.h"
 
+#include "vdyn/core/fields.h"
+
 #include "wishbone_corner.h"
 
 namespace vdyn {
@@ -67,25 +69,60 @@ void DoubleWishboneParams::validate(const std::string& w) const {
   requirePositive(spring_free_length_m, w + ".spring.free_length_m");
 }
 
+const FieldTable<DoubleWishboneParams>& DoubleWishboneParams::fields() {
+  using P = DoubleWishboneParams;
+  static const auto t =
+      FieldTable<P>()
+          .custom("bodies", "-", "required",
+                  "lower_arm, knuckle, upper_arm, wheel: {mass_kg, inertia_kg_m2 [3] (principal, about the c.m.)}",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader b = r.child("bodies");
+                    p.lower_arm = RigidBodyParams::fromParams(b.child("lower_arm"));
+                    p.knuckle = RigidBodyParams::fromParams(b.child("knuckle"));
+                    p.upper_arm = RigidBodyParams::fromParams(b.child("upper_arm"));
+                    p.wheel = RigidBodyParams::fromParams(b.child("wheel"));
+                  })
+          .sample(R"({"lower_arm": {"mass_kg": 0.5, "inertia_kg_m2": [0.5, 0.5, 0.5]},
+                      "knuckle": {"mass_kg": 5, "inertia_kg_m2": [1, 1, 1]},
+                      "upper_arm": {"mass_kg": 0.5, "inertia_kg_m2": [0.5, 0.5, 0.5]},
+                      "wheel": {"mass_kg": 20, "inertia_kg_m2": [1, 1.9, 1]}})")
+          .custom("joints", "m", "required",
+                  "lower_pivot, upper_pivot (revolute: parent/child point and axis point), lower_ball, upper_ball "
+                  "(parent/child point; upper_ball is the cut), wheel_spin_axis [0 1 0]; points in each body's frame",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader j = r.child("joints");
+                    p.lower_pivot = JointParams::fromParams(j.child("lower_pivot"), true);
+                    p.lower_ball = JointParams::fromParams(j.child("lower_ball"), false);
+                    p.upper_ball = JointParams::fromParams(j.child("upper_ball"), false);
+                    p.upper_pivot = JointParams::fromParams(j.child("upper_pivot"), true);
+                    p.wheel_spin_axis = j.vec3Or("wheel_spin_axis", p.wheel_spin_axis);
+                  })
+          .sample(R"({"lower_pivot": {"parent_point_m": [1.31, -0.295, -0.385], "child_point_m": [0, 0.132, 0.017],
+                                      "parent_axis_point_m": [1.41, -0.295, -0.385],
+                                      "child_axis_point_m": [0.1, 0.132, 0.017]},
+                      "lower_ball": {"parent_point_m": [0, -0.132, -0.017], "child_point_m": [0.01, 0.04, -0.12]},
+                      "upper_ball": {"parent_point_m": [0, -0.105, 0.027], "child_point_m": [-0.02, 0.05, 0.14]},
+                      "upper_pivot": {"parent_point_m": [1.28, -0.34, -0.215], "child_point_m": [0, 0.105, -0.027],
+                                      "parent_axis_point_m": [1.38, -0.34, -0.215],
+                                      "child_axis_point_m": [0.1, 0.105, -0.027]}})")
+          .custom("spring", "-", "required",
+                  "stiffness_N_per_m, damping_N_s_per_m, free_length_m, chassis_point_m (chassis frame), "
+                  "arm_point_m (lower arm frame, default 0)",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader s = r.child("spring");
+                    p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
+                    p.damper_N_s_per_m = s.number("damping_N_s_per_m");
+                    p.spring_free_length_m = s.number("free_length_m");
+                    p.spring_chassis_point_m = s.vec3("chassis_point_m");
+                    p.spring_arm_point_m = s.vec3Or("arm_point_m", Vec3(0));
+                  })
+          .sample(R"({"stiffness_N_per_m": 9.16e4, "damping_N_s_per_m": 1.44e4, "free_length_m": 0.344,
+                      "chassis_point_m": [1.31, -0.395, -0.1]})");
+  return t;
+}
+
 DoubleWishboneParams DoubleWishboneParams::fromParams(const ParamReader& r) {
-  DoubleWishboneParams p;
-  const ParamReader b = r.child("bodies");
-  p.lower_arm = RigidBodyParams::fromParams(b.child("lower_arm"));
-  p.knuckle = RigidBodyParams::fromParams(b.child("knuckle"));
-  p.upper_arm = RigidBodyParams::fromParams(b.child("upper_arm"));
-  p.wheel = RigidBodyParams::fromParams(b.child("wheel"));
-  const ParamReader j = r.child("joints");
-  p.lower_pivot = JointParams::fromParams(j.child("lower_pivot"), true);
-  p.lower_ball = JointParams::fromParams(j.child("lower_ball"), false);
-  p.upper_ball = JointParams::fromParams(j.child("upper_ball"), false);
-  p.upper_pivot = JointParams::fromParams(j.child("upper_pivot"), true);
-  p.wheel_spin_axis = j.vec3Or("wheel_spin_axis", p.wheel_spin_axis);
-  const ParamReader s = r.child("spring");
-  p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
-  p.damper_N_s_per_m = s.number("damping_N_s_per_m");
-  p.spring_free_length_m = s.number("free_length_m");
-  p.spring_chassis_point_m = s.vec3("chassis_point_m");
-  p.spring_arm_point_m = s.vec3Or("arm_point_m", Vec3(0));
+  DoubleWishboneParams p = fields().read(r);
   p.validate(r.where());
   return p;
 }

@@ -6,7 +6,7 @@
 
 #include "vdyn/core/text.h"
 #include "vdyn/vehicles/bicycle.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/quarter_car.h"
 
 namespace vdyn {
@@ -54,10 +54,14 @@ struct Geometry {
 
 Geometry geometryOf(const Vehicle& vehicle, double tireWidth) {
   Geometry g;
-  if (vehicle.type() == "fourws") {
-    const FourWsVehicle& car = vehicle.getConcrete<FourWsVehicle>();
-    const SimTK::Vec3 f = wheelCentreInChassis(car.cornerParams(RF)), r = wheelCentreInChassis(car.cornerParams(RR));
-    g.footprint = {vehicleWidth(2 * std::max(std::abs(f[1]), std::abs(r[1])), tireWidth), f[0], r[0]};
+  if (vehicle.type() == "wheeled" || vehicle.type() == "fourws") {
+    const WheeledVehicle& car = vehicle.getConcrete<WheeledVehicle>();
+    const SimTK::Vec3 f = car.suspension(0).calcWheelCentreInChassis(0),
+                      r = car.suspension(car.numAxles() - 1).calcWheelCentreInChassis(0);
+    double halfTrack = 0;
+    for (int ax = 0; ax < car.numAxles(); ++ax)
+      halfTrack = std::max(halfTrack, std::abs(car.suspension(ax).calcWheelCentreInChassis(0)[1]));
+    g.footprint = {vehicleWidth(2 * halfTrack, tireWidth), f[0], r[0]};
     g.wheelbase_m = f[0] - r[0];
     g.gravity_m_s2 = car.params().gravity_m_per_s2;
   } else if (vehicle.type() == "bicycle") {
@@ -67,7 +71,7 @@ Geometry geometryOf(const Vehicle& vehicle, double tireWidth) {
     g.wheelbase_m = p.front_axle_m[0] - p.rear_axle_m[0];
     g.gravity_m_s2 = p.gravity_m_per_s2;
   } else {
-    throw Error("handling tests run on vehicle types fourws and bicycle (their wheelbase and tracks), not '" +
+    throw Error("handling tests run on vehicle types wheeled (fourws) and bicycle (their wheelbase and tracks), not '" +
                 vehicle.type() + "'");
   }
   return g;
@@ -190,9 +194,9 @@ SuspensionCorner cornerOf(const std::string& name, const DoubleWishboneCorner& c
   return k;
 }
 
-VehicleReport makeFourWsReport(const HandlingScene& h, const std::vector<double>& travels) {
-  const FourWsVehicle& car = h.built.vehicleAs<FourWsVehicle>();
-  const FourWsParams& params = car.params();
+VehicleReport makeWheeledReport(const HandlingScene& h, const std::vector<double>& travels) {
+  const WheeledVehicle& car = h.built.vehicleAs<WheeledVehicle>();
+  const WheeledVehicleParams& params = car.params();
   const Scene& sc = h.built.scene();
   // Static equilibrium: the steady-state equations at zero speed (no speed
   // hold): the chassis x, y, yaw and wheel spin angles are ineffective, the
@@ -202,25 +206,25 @@ VehicleReport makeFourWsReport(const HandlingScene& h, const std::vector<double>
   SimTK::State s = r.state;
   sc.getSystem().realize(s, SimTK::Stage::Velocity);
   VehicleReport rep;
-  rep.vehicle = "4ws";
+  rep.vehicle = h.built.vehicle->type() == "fourws" ? "4ws" : h.built.vehicle->type();
   rep.method = "steady-state solver at zero speed (plugins/steady_state)";
   rep.iterations = r.iterations;
   rep.force_residual_N = r.force_residual;
   const double road = makeRoad(params.road)->height(0, 0, 0);
-  for (int c = 0; c < 4; ++c) {
-    const double fz = sc.evalOutput(std::string("tire_") + cornerName(c) + ".Fz_N", s);
-    rep.corner_loads_N.push_back({cornerName(c), fz});
-    (c < 2 ? rep.front_axle_load_N : rep.rear_axle_load_N) += fz;
+  for (int c = 0; c < car.numCorners(); ++c) {
+    const double fz = sc.evalOutput("tire_" + car.cornerName(c) + ".Fz_N", s);
+    rep.corner_loads_N.push_back({car.cornerName(c), fz});
+    (c < 2 ? rep.front_axle_load_N : rep.rear_axle_load_N) += fz;  // the first axle, and the others
     rep.total_load_N += fz;
   }
   rep.weight_N = car.totalMass() * params.gravity_m_per_s2;
   rep.chassis_origin_height_m = car.chassis().getBodyOriginLocation(s)[2] - road;
   rep.com_height_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[2] - road;
   const double y0 = car.chassis().getBodyOriginLocation(s)[1];
-  for (int c : {RF, RR}) {
-    SuspensionCorner k = cornerOf(cornerName(c), car.corner(c));
+  for (int ax = 0; ax < car.numAxles(); ++ax) {
+    SuspensionCorner k = cornerOf(car.cornerName(2 * ax), car.corner(2 * ax));
     k.centre_plane_y_m = y0;
-    rep.kinematics.push_back({c == RF ? "front" : "rear", calcSuspensionKinematics(sc, s, k, travels, road)});
+    rep.kinematics.push_back({params.axles[ax].name, calcSuspensionKinematics(sc, s, k, travels, road)});
   }
   return rep;
 }
@@ -255,17 +259,17 @@ VehicleReport makeQuarterCarReport(const BuiltScene& built, const std::vector<do
 
 VehicleReport makeVehicleReport(const SceneDescription& d, const std::vector<double>& travels) {
   const std::string type = d.json().at("vehicle").at("type").get<std::string>();
-  if (type == "fourws") {
+  if (type == "wheeled" || type == "fourws") {
     HandlingSetup setup;
     setup.speed_hold = false;
     const auto h = buildHandlingScene(d, setup);
-    VehicleReport rep = makeFourWsReport(*h, travels);
+    VehicleReport rep = makeWheeledReport(*h, travels);
     rep.replaced_plugins = h->replaced_plugins;
     rep.added_plugins = h->added_plugins;
     return rep;
   }
   if (type == "quarter_car") return makeQuarterCarReport(d.build(), travels);
-  throw Error(d.path() + ": vehicle_report runs on vehicle types fourws and quarter_car, not '" + type + "'");
+  throw Error(d.path() + ": vehicle_report runs on vehicle types wheeled (fourws) and quarter_car, not '" + type + "'");
 }
 
 }  // namespace vdyn

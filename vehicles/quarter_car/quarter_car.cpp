@@ -22,15 +22,16 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
   static const auto t =
       FieldTable<P>()
           .custom("vehicle_data", "-", "required",
-                  "App. A vehicle data file the corner and tire come from (with corner, corner_overrides, tire)",
+                  "wheeled vehicle data file the corner and tire come from (with corner, corner_overrides, tire)",
                   [](const ParamReader& r, P& p) {
                     const ParamReader vehicle = ParamReader::fromFile(r.string("vehicle_data"));
-                    const std::string cornerName = r.stringOr("corner", "front_right");
+                    const std::string axle = r.stringOr("corner", "front");
                     // The quarter car's own values are patched onto the vehicle data, so each
                     // value lives in one data file: the corner and tire from App. A, the
                     // chapter 4 values (m3, K, D, Cz, ...) in the quarter-car file.
-                    ParamReader corner = vehicle.child(cornerName);
+                    ParamReader corner = vehicle.child("axles").child(axle).child("suspension");
                     if (r.has("corner_overrides")) corner = corner.mergedWith(r.child("corner_overrides"));
+                    corner.has("template");  // a double wishbone in either formulation: the same corner
                     p.corner = DoubleWishboneParams::fromParams(corner);
                     corner.requireAllKeysRead();
                     if (r.has("tire")) {
@@ -41,7 +42,8 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
                     }
                   })
           .sample("\"appendix_a.json\"")
-          .custom("corner", "-", "\"front_right\"", "which corner of the vehicle data (read with vehicle_data)",
+          .custom("corner", "-", "\"front\"",
+                  "the axle of the vehicle data whose right double-wishbone corner this is (read with vehicle_data)",
                   [](const ParamReader& r, P&) { r.has("corner"); })
           .custom("corner_overrides", "-", "{}", "keys merged over the corner (read with vehicle_data)",
                   [](const ParamReader& r, P&) { r.has("corner_overrides"); })

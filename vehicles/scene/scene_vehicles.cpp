@@ -1,10 +1,10 @@
 // Scene-file adaptors of the built-in vehicles: each owns the concrete vehicle
-// (QuarterCar, Bicycle, FourWsVehicle) and exposes its scene, attachments and
+// (QuarterCar, Bicycle, WheeledVehicle) and exposes its scene, attachments and
 // initial state through vdyn::Vehicle.
 #include "vdyn/vehicles/scene_vehicles.h"
 
 #include "vdyn/vehicles/bicycle.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/quarter_car.h"
 
 namespace vdyn {
@@ -22,44 +22,49 @@ std::vector<FieldInfo> sceneVehicleKeys() {
           {"initial_speed_m_s", "m/s", "0", "forward speed of the initial state (wheels rolling)"}};
 }
 
-class FourWsSceneVehicle : public Vehicle {
+class WheeledSceneVehicle : public Vehicle {
  public:
-  FourWsSceneVehicle(const VehicleSpec& spec)
-      : Vehicle("fourws"), car_(FourWsParams::fromParams(spec.data), *spec.registry) {
+  WheeledSceneVehicle(const std::string& type, const VehicleSpec& spec)
+      : Vehicle(type), car_(WheeledVehicleParams::fromParams(spec.data, spec.registry), *spec.registry) {
     attachments_["chassis"] = {{"chassis", "chassis"}};
-    attachments_["wheels"] = {{"chassis", "chassis"}, {"wheels", "rf.wheel,lf.wheel,rr.wheel,lr.wheel"}};
-    for (int axle = 0; axle < 2; ++axle) {
-      const int r = axle == 0 ? RF : RR, l = axle == 0 ? LF : LR;
-      attachments_[axle == 0 ? "front_axle" : "rear_axle"] = {
+    std::string wheels;
+    for (int c = 0; c < car_.numCorners(); ++c) wheels += (c ? "," : "") + car_.cornerName(c) + ".wheel";
+    attachments_["wheels"] = {{"chassis", "chassis"}, {"wheels", wheels}};
+    for (int ax = 0; ax < car_.numAxles(); ++ax) {
+      const std::string r = car_.cornerName(2 * ax), l = car_.cornerName(2 * ax + 1);
+      attachments_[car_.params().axles[ax].name + "_axle"] = {
           {"chassis", "chassis"},
-          {"knuckles", std::string(cornerName(r)) + ".knuckle," + cornerName(l) + ".knuckle"},
-          {"spin_axis", axisText(car_.cornerParams(r).wheel_spin_axis)}};
+          {"knuckles", r + ".knuckle," + l + ".knuckle"},
+          {"spin_axis", axisText(car_.suspension(ax).getSpinAxis(0))}};
     }
-    for (int c = 0; c < 4; ++c) {
-      const std::string n = cornerName(c);
+    for (int c = 0; c < car_.numCorners(); ++c) {
+      const std::string n = car_.cornerName(c);
       attachments_[n] = {{"chassis", "chassis"},
                          {"wheel", n + ".wheel"},
                          {"knuckle", n + ".knuckle"},
                          {"knuckles", n + ".knuckle"},
-                         {"spin_axis", axisText(car_.cornerParams(c).wheel_spin_axis)}};
+                         {"spin_axis", axisText(car_.suspension(c / 2).getSpinAxis(c % 2))}};
     }
   }
 
  protected:
-  void* DoGetConcrete(const std::type_info& t) override { return t == typeid(FourWsVehicle) ? &car_ : nullptr; }
+  void* DoGetConcrete(const std::type_info& t) override { return t == typeid(WheeledVehicle) ? &car_ : nullptr; }
   Scene& DoUpdScene() override { return car_.updScene(); }
   SimTK::State DoMakeInitialState(double speed) const override {
     return car_.makeInitialState(speed, &assembly_);
   }
   Json DoDescribe(const SimTK::State& s) const override {
+    Json templates = Json::object();
+    for (int ax = 0; ax < car_.numAxles(); ++ax)
+      templates[car_.params().axles[ax].name] = car_.suspension(ax).templateName();
     return {{"total_mass_kg", car_.totalMass()},
             {"dof", car_.degreesOfFreedom(s)},
             {"assembly_max_body_move_m", assembly_.max_move_m},
-            {"corner_model", car_.params().corner_model}};
+            {"suspensions", templates}};
   }
 
  private:
-  FourWsVehicle car_;
+  WheeledVehicle car_;
   mutable AssemblyReport assembly_;
 };
 
@@ -141,11 +146,17 @@ TypeInfo info(const std::string& summary, const FieldTable<P>& data) {
 }  // namespace
 
 void registerVehicles(PluginRegistry& registry) {
-  registry.addVehicle(
-      "fourws", [](const VehicleSpec& s) { return std::make_unique<FourWsSceneVehicle>(s); },
-      info("App. A 4WS vehicle: free chassis, four double-wishbone corners, four tires; attachments chassis, "
-           "front_axle, rear_axle, rf, lf, rr, lr",
-           FourWsParams::fields()));
+  registerSuspensionTemplates(registry);
+  for (const char* type : {"wheeled", "fourws"}) {
+    TypeInfo t = info(std::string(type) == "fourws"
+                          ? "the wheeled vehicle under the App. A car's name (kept so scenes naming it keep working)"
+                          : "wheeled vehicle: a free chassis and axles composed from templates (suspension per axle, "
+                            "tire per axle); attachments chassis, wheels, <axle>_axle (front_axle, ...), each corner "
+                            "(rf, lf, ...)",
+                      WheeledVehicleParams::fields());
+    registry.addVehicle(
+        type, [type](const VehicleSpec& s) { return std::make_unique<WheeledSceneVehicle>(type, s); }, std::move(t));
+  }
   registry.addVehicle(
       "bicycle", [](const VehicleSpec& s) { return std::make_unique<BicycleSceneVehicle>(s); },
       info("nonlinear bicycle (section 7.1): free chassis, steered fork, two axles of two tires; attachments "

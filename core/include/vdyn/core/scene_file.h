@@ -52,7 +52,7 @@ struct BuiltScene {
 
   Scene& scene() { return vehicle->updScene(); }
   const Scene& scene() const { return vehicle->getScene(); }
-  /// The concrete vehicle (e.g. FourWsVehicle) for code that needs its own
+  /// The concrete vehicle (e.g. WheeledVehicle) for code that needs its own
   /// C++ API; throws Error if the scene's vehicle is another (Vehicle::getConcrete).
   template <class V>
   V& vehicleAs() { return vehicle->getConcrete<V>(); }

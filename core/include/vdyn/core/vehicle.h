@@ -55,7 +55,7 @@ class Vehicle {
   /// design's values (a datum) while it perturbs others. {} if none.
   Json derivedData() const { return DoGetDerivedData(); }
 
-  /// The concrete vehicle behind this builder (FourWsVehicle for "fourws",
+  /// The concrete vehicle behind this builder (WheeledVehicle for "fourws",
   /// Bicycle, QuarterCar), for code that needs its own C++ API on a vehicle a
   /// scene composed (e.g. ch3_work_precision maps the reduced model's state
   /// from the constrained one's): the scene stays the one composition. Throws

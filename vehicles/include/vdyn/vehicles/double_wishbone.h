@@ -12,6 +12,7 @@
 
 #include <Simbody.h>
 
+#include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 #include "vdyn/core/scene.h"
 
@@ -53,6 +54,8 @@ struct DoubleWishboneParams {
   SimTK::Vec3 spring_arm_point_m{0, 0, 0};  ///< on the lower arm
 
   void validate(const std::string& where) const;
+  /// The data-file keys of one corner: "bodies", "joints", "spring".
+  static const FieldTable<DoubleWishboneParams>& fields();
   static DoubleWishboneParams fromParams(const ParamReader& r);
   /// The left-side corner from a right-side one: points mirrored eta -> -eta,
   /// axes as axial vectors (so the spin axis stays +eta and forward rolling

@@ -16,7 +16,7 @@
 #include "vdyn/handling/iso3888.h"
 #include "vdyn/handling/vehicle_report.h"
 #include "vdyn/vehicles/bicycle.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/quarter_car.h"
 
 namespace vdyn {

@@ -29,7 +29,7 @@
 // on the constraint manifold. The drift stays at the integrator's error
 // level (ch3_work_precision reports it).
 //
-// Active only in a state where FourWsVehicle::useDenseRows() set its flag
+// Active only in a state where WheeledVehicle::useDenseRows() set its flag
 // (and disabled the Simbody constraints it replaces); in every other state
 // this force does nothing and the Simbody rows act. Simbody's constraint
 // multipliers are not available in a dense state; the speed hold's force
@@ -54,7 +54,7 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   ReducedDenseRows(const SimTK::SimbodyMatterSubsystem& matter, const SimTK::GeneralForceSubsystem& forces)
       : matter_(&matter), forces_(&forces) {}
 
-  /// The rows (set by FourWsVehicle::useDenseRows before the first dense state).
+  /// The rows (set by WheeledVehicle::useDenseRows before the first dense state).
   struct Arm {
     SimTK::MobilizedBody::Pin lower, upper;
     SimTK::MobilizedBody::Custom knuckle;

@@ -180,12 +180,12 @@ struct ReducedWishboneCorner {
   SimTK::MobilizedBody::Pin wheel;
   SimTK::Force::TwoPointLinearSpring spring;
   SimTK::Force::TwoPointLinearDamper damper;
-  const WishboneLoop* loop = nullptr;  ///< owned by the caller (FourWsVehicle)
+  const WishboneLoop* loop = nullptr;  ///< owned by the caller (WheeledVehicle)
 };
 
 /// The reduced corner (bodies registered as in buildDoubleWishbone). Its two
 /// arm rows are not added here: collect armPlaneRows() of every corner into
-/// one ArmPlanesImpl (FourWsVehicle does).
+/// one ArmPlanesImpl (WheeledVehicle does).
 ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& chassis, const DoubleWishboneParams& p,
                                            const WishboneLoop& loop, const std::string& prefix);
 

@@ -66,7 +66,7 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   /// Stage::Acceleration).
   double calcForce(const SimTK::State& s) const;
   /// For a model that solves this row itself with the constraint disabled in
-  /// its states (FourWsVehicle::useDenseRows): calcForce reads the force from
+  /// its states (WheeledVehicle::useDenseRows): calcForce reads the force from
   /// `force` (N, same sign) in a state where the constraint is disabled.
   void setDisabledForceSource(std::function<double(const SimTK::State&)> force) const {
     disabledForce_ = std::move(force);

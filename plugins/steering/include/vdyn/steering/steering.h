@@ -214,7 +214,7 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
   std::shared_ptr<const SteeringCommand> sharedCommand() const { return command_; }
   /// Names of the chassis and knuckle bodies and the knuckle's spin axis (K
   /// frame): what a vehicle that solves the steering rows itself needs
-  /// (FourWsVehicle::useDenseRows).
+  /// (WheeledVehicle::useDenseRows).
   const std::string& chassisBody() const { return chassis_; }
   const std::vector<std::string>& knuckleBodies() const { return knuckles_; }
   const SimTK::UnitVec3& spinAxis() const { return spin_K_; }

@@ -1,0 +1,119 @@
+#pragma once
+// Suspension templates: what one axle of a WheeledVehicle is made of.
+//
+// A template is a class registered by name in the plugin registry's choice
+// family "suspension_template" (the data file's
+// "suspension": {"template": "<name>", ...}), with its parameter struct, its
+// field table (`vdyn list double_wishbone` shows its keys)
+// and a builder that adds the right and the left corner of the axle to a
+// scene under the chassis. Each built corner names its bodies by role
+// (<prefix>wheel, <prefix>knuckle, <prefix>lower_arm, ...), so plugins and
+// analyses reach them as typed attachments, never by parsing names.
+//
+// Adding a template: a folder vehicles/templates/<name>/ with a class deriving
+// from Suspension (its parameter struct read through a FieldTable) and a
+// register function, and one line in registerSuspensionTemplates()
+// (suspension.cpp); a library outside the tree calls addChoice from its
+// vdyn_register_plugins.
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <Simbody.h>
+
+#include "vdyn/core/fields.h"
+#include "vdyn/core/params.h"
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+#include "vdyn/tire/tire_model.h"
+#include "vdyn/vehicles/reduced_dense.h"
+
+namespace vdyn {
+
+/// Index of a side within an axle: right (0) then left (1), the seed's order
+/// (14 RF before 15 LF).
+inline int sideIndex(WheelSide side) { return side == WheelSide::Right ? 0 : 1; }
+
+/// One axle's suspension: both corners, their parameters and, once built,
+/// their handles. Constant once built (the state holds everything that moves).
+class Suspension {
+ public:
+  virtual ~Suspension() = default;
+  Suspension(const Suspension&) = delete;
+  Suspension& operator=(const Suspension&) = delete;
+
+  /// The registered template name ("double_wishbone", ...).
+  const std::string& templateName() const { return template_; }
+
+  /// Adds both corners to `scene` under `chassis`: right first, then left (the
+  /// order Simbody numbers the bodies). A corner's bodies are registered as
+  /// prefix + role (prefixes[0] right, prefixes[1] left, e.g. "rf.", "lf.").
+  /// `buildCorner(side)` runs between the two (the vehicle adds the tire
+  /// there, so the order of plugins is corner by corner).
+  void build(Scene& scene, SimTK::MobilizedBody& chassis, const std::string (&prefixes)[2],
+             const std::function<void(int side)>& afterCorner);
+
+  /// Body roles of one corner, in build order ("lower_arm", "knuckle", ...):
+  /// every one is registered as prefix + role. "wheel" and "knuckle" (the
+  /// steered body carrying the wheel's spin joint) are always present.
+  virtual std::vector<std::string> bodyRoles() const = 0;
+  /// Bodies whose mass is carried by the tires beside the chassis, kg (one corner).
+  virtual double calcCornerMass(int side) const = 0;
+  /// The wheel centre in the chassis frame in the tabulated configuration, m.
+  virtual SimTK::Vec3 calcWheelCentreInChassis(int side) const = 0;
+  /// The wheel's spin axis in the knuckle frame (unit; +eta on both sides).
+  virtual SimTK::UnitVec3 getSpinAxis(int side) const = 0;
+  /// The corner's suspension coordinate in state s (rad or m, per template):
+  /// what a vehicle report plots wheel travel against.
+  virtual double getSuspensionCoordinate(const SimTK::State& s, int side) const = 0;
+  /// Largest separation of a loop's cut joint in s before assembly, m (0 for
+  /// a loop closed by construction).
+  virtual double calcLoopGap(const SimTK::State& /*s*/, int /*side*/) const { return 0; }
+
+  /// The template whose assembled configuration this one starts from (the
+  /// reduced corner starts where the constrained one assembles, so both
+  /// models of one mechanism start from one state); empty: assembles itself.
+  virtual std::string getAssemblyTemplate() const { return ""; }
+  /// Sets this corner's coordinates in `s` to the configuration of the
+  /// corner of the same side of `from` (a suspension of getAssemblyTemplate())
+  /// in `fs`, with `delta` the (A.1) steering angle of its knuckle.
+  virtual void setPositionFrom(SimTK::State& s, int side, const Suspension& from, const SimTK::State& fs,
+                               double delta_rad) const;
+
+  /// Rows this template asks the vehicle to gather into one ArmPlanesImpl
+  /// (one constraint object for the whole vehicle); empty by default.
+  virtual std::vector<ArmPlanesImpl::Row> getArmRows(int /*side*/) const { return {}; }
+  /// The corner as the dense forward dynamics sees it; false if the template
+  /// has no dense formulation (then the vehicle cannot use the dense path).
+  virtual bool getDenseArm(int /*side*/, ReducedDenseRows::Arm* /*arm*/) const { return false; }
+
+ protected:
+  explicit Suspension(std::string templateName) : template_(std::move(templateName)) {}
+  virtual void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) = 0;
+
+ private:
+  std::string template_;
+};
+
+/// The registry's choice family of suspension templates: a data file's
+/// "suspension": {"template": NAME, ...} picks one (`vdyn list` prints them
+/// with their keys); an out-of-tree library adds one with
+///   registry.addChoice<Suspension>(kSuspensionFamily, NAME, factory, typeInfo(...))
+/// in its vdyn_register_plugins.
+inline constexpr const char* kSuspensionFamily = "suspension_template";
+
+/// Creates the unbuilt suspension the block's "template" key names, from the
+/// block's other keys; throws Error naming the block and the known templates
+/// for an unknown name, and any key the template did not read.
+std::unique_ptr<Suspension> makeSuspension(const PluginRegistry& registry, const ParamReader& block);
+
+/// Registers the built-in templates (one line each, in suspension.cpp).
+void registerSuspensionTemplates(PluginRegistry& registry);
+
+/// builtinPlugins() with the built-in suspension templates: the registry the
+/// vehicles' C++ constructors use when none is given.
+const PluginRegistry& vehiclePlugins();
+
+}  // namespace vdyn

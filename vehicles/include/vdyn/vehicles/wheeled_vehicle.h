@@ -1,0 +1,185 @@
+#pragma once
+// The generic wheeled vehicle: a chassis on a free (6-dof) mobilizer and a list
+// of axles, each composed in data from subsystem templates (suspension.h): a
+// "suspension" block whose "template" key picks the class, and a tire (any
+// registered tire kind). The left corner of an axle is the mirror of the right
+// unless the data gives it. The seed's Appendix A four-wheel-steering vehicle
+// is this vehicle on appendix_a.json (two double-wishbone axles; the registered
+// type "fourws" is kept as its name). Steering constraints are plugins added on
+// top (without them each knuckle turns freely about its kingpin: App. A has 18
+// degrees of freedom; with four, 14).
+//
+// Data layout (vdyn list wheeled):
+//   {"chassis": {mass_kg, inertia_kg_m2},
+//    "tire": {"plugin": KIND, "params": {...}},     // every axle's, unless its own
+//    "axles": {"front": {"suspension": {"template": "double_wishbone", ...},
+//                        "tire": {...}},             // optional, merged over "tire"
+//              "rear": {...}},
+//    "road": {...}, "gravity_m_per_s2": 9.81, "forward_dynamics": "simbody"}
+// Axles are ordered front to rear by their wheel centres' xi; a corner's
+// bodies are prefixed "<r|l><first letter of the axle>." ("rf.", "lr.") unless
+// the axle gives "prefixes": ["rf", "lf"].
+#include <array>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "vdyn/core/registry.h"
+#include "vdyn/core/scene.h"
+#include "vdyn/steering/steering.h"
+#include "vdyn/tire/road.h"
+#include "vdyn/tire/tire_force.h"
+#include "vdyn/vehicles/assembly.h"
+#include "vdyn/vehicles/double_wishbone.h"
+#include "vdyn/vehicles/reduced_dense.h"
+#include "vdyn/vehicles/reduced_wishbone.h"
+#include "vdyn/templates/double_wishbone.h"
+#include "vdyn/vehicles/suspension.h"
+
+namespace vdyn {
+
+/// Corner index c = 2 axle + side (side 0 right, 1 left): on a two-axle car
+/// the seed's wheel numbering 14 RF, 15 LF, 16 RR, 17 LR.
+enum Corner { RF = 0, LF = 1, RR = 2, LR = 3 };
+
+/// A subsystem chosen in data: the registered template's name and its block,
+/// read when the vehicle is built (as TireChoice for tires).
+struct SuspensionChoice {
+  Json block = Json::object();   ///< the "suspension" block, with its "template" key
+  std::string where = "suspension";  ///< its data-file location, for messages
+  std::string templateName() const;
+  /// A new unbuilt suspension of this block from `registry`'s templates (validates it).
+  std::unique_ptr<Suspension> create(const PluginRegistry& registry) const;
+};
+
+struct AxleParams {
+  std::string name;                    ///< the key in "axles" ("front", "rear")
+  std::array<std::string, 2> prefixes; ///< corner names, right and left ("rf", "lf")
+  SuspensionChoice suspension;
+  TireChoice tire;                     ///< this axle's tire kind and params
+  double wheel_centre_x_m = 0;         ///< xi of the right wheel centre (tabulated), for the order
+};
+
+struct WheeledVehicleParams {
+  RigidBodyParams chassis;               ///< App. A body 1 (800 kg; 250/1000/1100 kg m^2)
+  std::vector<AxleParams> axles;         ///< front to rear
+  RoadParams road;                       ///< flat by default
+  double gravity_m_per_s2 = 9.81;        ///< along -z, m/s^2
+  /// Data-file key "forward_dynamics": "simbody" (default; the constraint
+  /// rows solved by Simbody, projected each step) or "dense" (every axle's
+  /// template must have a dense formulation, double_wishbone_reduced: the
+  /// rows solved as one dense system per evaluation, with Baumgarte drift
+  /// control; time-commanded steering only; see reduced_dense.h).
+  /// makeInitialState and makeStateLike return dense states.
+  std::string forward_dynamics = "simbody";
+
+  void validate() const;
+  /// The axle named `name`; throws Error listing the axles.
+  const AxleParams& axle(const std::string& name) const;
+  AxleParams& updAxle(const std::string& name);
+  /// Sets every axle's suspension template (e.g. "double_wishbone_reduced").
+  void setSuspensionTemplate(const std::string& name);
+  /// The data-file keys fromParams reads (`vdyn list wheeled`): the one key list.
+  static const FieldTable<WheeledVehicleParams>& fields();
+  /// The suspension templates come from `registry` (default vehiclePlugins()).
+  static WheeledVehicleParams fromParams(const ParamReader& r, const PluginRegistry* registry = nullptr);
+  static WheeledVehicleParams fromFile(const std::string& path, const PluginRegistry* registry = nullptr);
+};
+
+class WheeledVehicle {
+ public:
+  /// Tires and suspension templates from vehiclePlugins().
+  explicit WheeledVehicle(const WheeledVehicleParams& params);
+  /// Tires and suspension templates from `registry`.
+  WheeledVehicle(const WheeledVehicleParams& params, const PluginRegistry& registry);
+
+  Scene& updScene() { return *scene_; }
+  const Scene& getScene() const { return *scene_; }
+  const WheeledVehicleParams& params() const { return p_; }
+
+  int numAxles() const { return int(axles_.size()); }
+  int numCorners() const { return 2 * numAxles(); }
+  /// The axle index of `name` ("front"); throws Error listing the axles.
+  int axleIndex(const std::string& name) const;
+  /// The corner name ("rf"): the prefix of its bodies, outputs and tire plugin.
+  const std::string& cornerName(int c) const { return p_.axles.at(c / 2).prefixes[c % 2]; }
+  /// The built suspension of an axle.
+  const Suspension& suspension(int axle) const { return *axles_.at(axle).suspension; }
+  /// The suspension of an axle as template class S; throws Error naming the
+  /// axle and its template if it is not one.
+  template <class S>
+  const S& suspensionAs(int axle) const {
+    if (const auto* s = dynamic_cast<const S*>(&suspension(axle))) return *s;
+    throwNotTemplate(axle, typeid(S).name());
+  }
+
+  /// The tabulated configuration (chassis c.m. at the height where the tires
+  /// carry about the weight, level, at the origin heading +x), the loops
+  /// closed by assembly, moving forward at `speed_m_s` with the wheels rolling.
+  /// An axle whose template starts from another template's assembly (the
+  /// reduced double wishbone from the constrained one's) takes its
+  /// configuration from a copy of the vehicle with that template, its axle
+  /// steering held at the initial angles, so both models start from one state.
+  SimTK::State makeInitialState(double speed_m_s = 0.0, AssemblyReport* report = nullptr) const;
+
+  /// Adds a steering plugin that commands both wheels of `axle` ("front",
+  /// "rear") with the same angle; call before making states.
+  const SteeringPlugin& addAxleSteering(const std::string& name, const std::string& axle,
+                                        std::shared_ptr<const SteeringCommand> command);
+  /// The same, state-driven: a controller plugin sets delta'' (see SteeringPlugin).
+  SteeringPlugin& addAxleSteering(const std::string& name, const std::string& axle, const SteeringStateSpec& state);
+
+  double totalMass() const;
+  /// Mobilities minus constraint equations (the chassis quaternion counts as 3).
+  int degreesOfFreedom(const SimTK::State& s) const;
+
+  const SimTK::MobilizedBody::Free& chassis() const { return chassis_; }
+  /// The constrained double-wishbone corner c (throws Error on another template).
+  const DoubleWishboneCorner& corner(int c) const;
+  /// True if every axle is double_wishbone_reduced.
+  bool isReduced() const;
+  /// The reduced corner c (throws Error on another template).
+  const ReducedWishboneCorner& reducedCorner(int c) const;
+  /// Suspension coordinate of a corner (the double wishbone's lower-arm pivot angle, rad).
+  double suspensionAngle(const SimTK::State& s, int c) const;
+  /// Every axle reduced: a state of this vehicle in the configuration and
+  /// motion of `other` (a vehicle of the same data, either model) in state
+  /// `os`: chassis, lower-arm angles, steering angles of (A.1), wheel spins,
+  /// their rates, time and z variables (same plugins in the same order).
+  /// The arm angles follow from s; the state is projected to the constraints.
+  SimTK::State makeStateLike(const WheeledVehicle& other, const SimTK::State& os) const;
+  /// Switches `s` to dense forward dynamics (see reduced_dense.h): every
+  /// constraint row of the scene (arm rows, the steering plugins'
+  /// time-commanded rows, speed holds) is disabled in `s` and solved by
+  /// ReducedDenseRows instead. Throws Error (naming it) if an axle's template
+  /// has no dense formulation or for a row it cannot solve (a state-driven
+  /// steering plugin, any other constraint). Call after every plugin has been added.
+  void useDenseRows(SimTK::State& s) const;
+  /// The dense rows' force element (null unless every axle supports them).
+  const ReducedDenseRows* denseRows() const { return dense_; }
+  const TirePlugin& tire(int c) const { return *tires_.at(c); }
+  /// The double-wishbone data of corner c (either formulation; throws Error on another template).
+  const DoubleWishboneParams& cornerParams(int c) const;
+
+ private:
+  [[noreturn]] void throwNotTemplate(int axle, const char* what) const;
+  WheeledVehicleParams p_;
+  std::unique_ptr<Scene> scene_;
+  SimTK::MobilizedBody::Free chassis_;
+  struct Axle {
+    std::unique_ptr<Suspension> suspension;
+  };
+  std::vector<Axle> axles_;
+  ReducedDenseRows* dense_ = nullptr;  ///< owned by its Force::Custom
+  std::shared_ptr<const PluginRegistry> registry_;  ///< for the copy an assembly template needs
+  struct AxleSteering {
+    std::string name;
+    std::string axle;
+    std::shared_ptr<const SteeringCommand> command;  ///< null: state-driven
+    double initial_angle_rad;
+  };
+  std::vector<AxleSteering> axleSteering_;
+  std::vector<const TirePlugin*> tires_;
+};
+
+}  // namespace vdyn

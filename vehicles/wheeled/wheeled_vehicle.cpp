@@ -1,0 +1,475 @@
+#include "vdyn/vehicles/wheeled_vehicle.h"
+
+#include <algorithm>
+#include <set>
+
+#include "vdyn/vehicles/chassis_outputs.h"
+
+#include "vdyn/core/simulation.h"
+#include "vdyn/plugins/builtin.h"
+#include "vdyn/speed/speed_hold.h"
+
+namespace vdyn {
+
+using SimTK::Vec3;
+
+std::string SuspensionChoice::templateName() const { return block.value("template", std::string()); }
+
+std::unique_ptr<Suspension> SuspensionChoice::create(const PluginRegistry& registry) const {
+  return makeSuspension(registry, ParamReader::fromJson(block, where));
+}
+
+void WheeledVehicleParams::validate() const {
+  chassis.validate("vehicle chassis");
+  if (axles.empty()) throw Error("vehicle axles: a wheeled vehicle needs at least one axle");
+  std::set<std::string> names;
+  for (const AxleParams& a : axles) {
+    if (a.tire.plugin.empty()) throw Error("vehicle axles." + a.name + ".tire: empty tire plugin name");
+    for (const std::string& n : a.prefixes)
+      if (n.empty() || !names.insert(n).second)
+        throw Error("vehicle axles." + a.name + ".prefixes: corner name '" + n + "' is empty or taken by another axle");
+  }
+  makeRoad(road);
+  requireNonNegative(gravity_m_per_s2, "vehicle gravity_m_per_s2");
+  if (forward_dynamics != "simbody" && forward_dynamics != "dense")
+    throw Error("vehicle forward_dynamics must be \"simbody\" or \"dense\", got \"" + forward_dynamics + "\"");
+}
+
+const AxleParams& WheeledVehicleParams::axle(const std::string& name) const {
+  return const_cast<WheeledVehicleParams*>(this)->updAxle(name);
+}
+
+AxleParams& WheeledVehicleParams::updAxle(const std::string& name) {
+  std::string known;
+  for (AxleParams& a : axles) {
+    if (a.name == name) return a;
+    known += (known.empty() ? "" : ", ") + a.name;
+  }
+  throw Error("vehicle has no axle '" + name + "' (axles: " + known + ")");
+}
+
+void WheeledVehicleParams::setSuspensionTemplate(const std::string& name) {
+  for (AxleParams& a : axles) a.suspension.block["template"] = name;
+}
+
+namespace {
+
+/// Reads "axles": each axle's suspension (created once here, so a bad block
+/// is an error at load), its tire over the vehicle's "tire", its corner
+/// names; ordered front to rear by the right wheel centre's xi.
+std::vector<AxleParams> readAxles(const ParamReader& r, const PluginRegistry& registry) {
+  const ParamReader all = r.child("axles");
+  if (!all.json().is_object() || all.json().empty())
+    throw Error(all.where() + ": expected an object of axles by name, e.g. {\"front\": {...}, \"rear\": {...}}");
+  std::vector<AxleParams> axles;
+  for (const auto& [name, value] : all.json().items()) {
+    const ParamReader a = all.child(name);
+    AxleParams ax;
+    ax.name = name;
+    const ParamReader sb = a.child("suspension");
+    ax.suspension.block = sb.json();
+    ax.suspension.where = sb.where();
+    const std::unique_ptr<Suspension> susp = makeSuspension(registry, sb);
+    ax.wheel_centre_x_m = susp->calcWheelCentreInChassis(0)[0];
+    if (a.has("tire")) {
+      const ParamReader own = a.child("tire");
+      ax.tire = r.has("tire") ? TireChoice::fromParams(r.child("tire"), &own) : TireChoice::fromParams(own);
+    } else {
+      if (!r.has("tire"))
+        throw Error(a.where() + ": tire: missing (give the axle a tire or the vehicle a \"tire\" for every axle)");
+      ax.tire = TireChoice::fromParams(r.child("tire"));
+    }
+    if (a.has("prefixes")) {
+      const Json& p = a.raw("prefixes");
+      if (!p.is_array() || p.size() != 2 || !p[0].is_string() || !p[1].is_string())
+        throw Error(a.where() + ".prefixes: expected [right, left] corner names, got " + p.dump());
+      ax.prefixes = {p[0].get<std::string>(), p[1].get<std::string>()};
+    } else {
+      ax.prefixes = {std::string("r") + name[0], std::string("l") + name[0]};
+    }
+    a.requireAllKeysRead();
+    axles.push_back(std::move(ax));
+  }
+  std::stable_sort(axles.begin(), axles.end(),
+                   [](const AxleParams& x, const AxleParams& y) { return x.wheel_centre_x_m > y.wheel_centre_x_m; });
+  if (r.has("tire")) r.child("tire").markAllRead();  // read by every axle that has no tire of its own
+  return axles;
+}
+
+}  // namespace
+
+const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
+  using P = WheeledVehicleParams;
+  static const auto t =
+      FieldTable<P>()
+          .custom("chassis", "-", "required", "rigid body: mass_kg, inertia_kg_m2 [3] (principal, about the c.m.)",
+                  [](const ParamReader& r, P& p) { p.chassis = RigidBodyParams::fromParams(r.child("chassis")); })
+          .custom("tire", "-", "none",
+                  "every axle's tire unless it has its own: {\"plugin\": gim|fiala|linear|magic_formula|..., "
+                  "\"params\": {the kind's 'params: ...' keys (vdyn list gim)}}",
+                  [](const ParamReader&, P&) {})  // read with the axles
+          .custom("axles", "-", "required",
+                  "{NAME: {\"suspension\": {\"template\": double_wishbone|double_wishbone_reduced|..., the "
+                  "template's keys (right corner; \"left\" if not its mirror)}, \"tire\": {merged over the "
+                  "vehicle's tire}, \"prefixes\": [right, left] (default r<N>, l<N>)}}, ordered front to rear",
+                  [](const ParamReader&, P&) {})  // read by fromParams, with the registry
+          .custom("road", "-", "{\"type\": \"flat\"}", "road: {\"type\": flat|sine, ...}",
+                  [](const ParamReader& r, P& p) {
+                    if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
+                  })
+          .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
+          .string("forward_dynamics", &P::forward_dynamics,
+                  "simbody | dense (every axle double_wishbone_reduced: the constraint rows solved as one dense "
+                  "system)");
+  return t;
+}
+
+WheeledVehicleParams WheeledVehicleParams::fromParams(const ParamReader& r, const PluginRegistry* registry) {
+  WheeledVehicleParams p = fields().read(r);
+  p.axles = readAxles(r, registry ? *registry : vehiclePlugins());
+  r.requireAllKeysRead();
+  p.validate();
+  return p;
+}
+
+WheeledVehicleParams WheeledVehicleParams::fromFile(const std::string& path, const PluginRegistry* registry) {
+  return fromParams(ParamReader::fromFile(path), registry);
+}
+
+WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params) : WheeledVehicle(params, vehiclePlugins()) {}
+
+WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginRegistry& registry)
+    : p_(params), scene_(std::make_unique<Scene>()) {
+  p_.validate();
+  Scene& sc = *scene_;
+  SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
+  chassis_ = SimTK::MobilizedBody::Free(sc.updMatter().Ground(), SimTK::Transform(), makeRigidBody(p_.chassis),
+                                        SimTK::Transform());
+  sc.addBody("chassis", chassis_);
+  sc.setService<const Road>("road", makeRoad(p_.road));
+  for (std::size_t ai = 0; ai < p_.axles.size(); ++ai) {
+    const AxleParams& ap = p_.axles[ai];
+    axles_.push_back({ap.suspension.create(registry)});
+    Suspension& susp = *axles_.back().suspension;
+    const std::string prefixes[2] = {ap.prefixes[0] + ".", ap.prefixes[1] + "."};
+    susp.build(sc, chassis_, prefixes, [&](int side) {
+      const std::string& n = ap.prefixes[side];
+      const PluginSpec spec = ap.tire.makeSpec("tire_" + n, prefixes[side] + "wheel",
+                                               Json{{"side", side == 0 ? "right" : "left"}});
+      const auto* tire = dynamic_cast<const TirePlugin*>(
+          &sc.addPlugin(registry.create(PluginKind::ForceElement, ap.tire.plugin, spec, ap.tire.where + ".plugin")));
+      if (!tire) throw Error(ap.tire.where + ".plugin: '" + ap.tire.plugin + "' is not a tire plugin");
+      tires_.push_back(tire);
+      const SimTK::MobilizedBody wheel = sc.getBody(prefixes[side] + "wheel");
+      sc.addOutput({prefixes[side] + "spin_rad_s", "rad/s", SimTK::Stage::Velocity,
+                    [wheel](const SimTK::State& s) { return wheel.getOneU(s, 0); }});
+    });
+  }
+  // Rows the templates gather into one constraint object for the whole vehicle.
+  std::vector<ArmPlanesImpl::Row> rows;
+  bool dense = true;
+  for (const Axle& a : axles_)
+    for (int side = 0; side < 2; ++side) {
+      const auto r = a.suspension->getArmRows(side);
+      rows.insert(rows.end(), r.begin(), r.end());
+      ReducedDenseRows::Arm arm;
+      dense = dense && a.suspension->getDenseArm(side, &arm);
+    }
+  if (!rows.empty()) SimTK::Constraint::Custom(new ArmPlanesImpl(sc.updMatter(), rows));
+  for (const Axle& a : axles_)
+    if (!a.suspension->getAssemblyTemplate().empty() && !registry_)
+      registry_ = std::make_shared<PluginRegistry>(registry);  // for the copy makeInitialState assembles
+  if (dense) {
+    dense_ = new ReducedDenseRows(sc.getMatter(), sc.getForces());
+    SimTK::Force::Custom(sc.updForces(), dense_);  // inactive until useDenseRows()
+  } else if (p_.forward_dynamics == "dense") {
+    for (const Axle& a : axles_) {
+      ReducedDenseRows::Arm arm;
+      if (!a.suspension->getDenseArm(0, &arm))
+        throw Error("vehicle forward_dynamics \"dense\" needs every axle's suspension template to have a dense "
+                    "formulation (double_wishbone_reduced); axle '" + p_.axles[&a - axles_.data()].name +
+                    "' is " + a.suspension->templateName());
+    }
+  }
+  addChassisOutputs(sc, chassis_);
+}
+
+int WheeledVehicle::axleIndex(const std::string& name) const {
+  for (std::size_t i = 0; i < p_.axles.size(); ++i)
+    if (p_.axles[i].name == name) return int(i);
+  p_.axle(name);  // throws, listing the axles
+  return -1;
+}
+
+void WheeledVehicle::throwNotTemplate(int axle, const char* what) const {
+  throw Error("vehicle axle '" + p_.axles.at(axle).name + "' has suspension template '" +
+              suspension(axle).templateName() + "', not the one this needs (" + what + ")");
+}
+
+const SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, const std::string& axle,
+                                                      std::shared_ptr<const SteeringCommand> command) {
+  const int ax = axleIndex(axle);
+  axleSteering_.push_back({name, axle, command, 0.0});
+  auto plugin = std::make_unique<SteeringPlugin>(
+      name, "chassis", std::vector<std::string>{cornerName(2 * ax) + ".knuckle", cornerName(2 * ax + 1) + ".knuckle"},
+      std::move(command), suspension(ax).getSpinAxis(0));
+  return static_cast<const SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
+}
+
+SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, const std::string& axle,
+                                                const SteeringStateSpec& state) {
+  const int ax = axleIndex(axle);
+  axleSteering_.push_back({name, axle, nullptr, state.initial_angle_rad});
+  auto plugin = std::make_unique<SteeringPlugin>(
+      name, "chassis", std::vector<std::string>{cornerName(2 * ax) + ".knuckle", cornerName(2 * ax + 1) + ".knuckle"},
+      state, suspension(ax).getSpinAxis(0));
+  return static_cast<SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
+}
+
+double WheeledVehicle::totalMass() const {
+  double m = p_.chassis.mass_kg;
+  for (const Axle& a : axles_)
+    for (int side = 0; side < 2; ++side) m += a.suspension->calcCornerMass(side);
+  return m;
+}
+
+int WheeledVehicle::degreesOfFreedom(const SimTK::State& s) const {
+  scene_->getSystem().realize(s, SimTK::Stage::Instance);
+  // A state-driven steering plugin's steer body moves by a prescribed acceleration.
+  const int denseRows = dense_ && dense_->isActive(s) ? dense_->numRows() : 0;  // rows Simbody does not see
+  return s.getNU() - s.getNUDotErr() - denseRows - static_cast<int>(steeringStateBodies(*scene_).size());
+}
+
+SimTK::State WheeledVehicle::makeInitialState(double speed, AssemblyReport* report) const {
+  requireFinite(speed, "vehicle initial speed_m_s");
+  const SimTK::MultibodySystem& system = scene_->getSystem();
+  SimTK::State s = scene_->getDefaultState();
+  const double road0 = makeRoad(p_.road)->height(0, 0, 0);
+  // Each tire at its static deflection under an equal share of the weight; the
+  // chassis at the mean of the heights that put each wheel there (written as
+  // h_0 + mean(h_c - h_0), exactly h_0 when the corners agree).
+  const int n = numCorners();
+  const double fz = totalMass() * p_.gravity_m_per_s2 / n;
+  auto cornerHeight = [&](int c) {
+    const TireModel& tire = tires_[c]->getModel();
+    return tire.vertical().unloaded_radius_m - calcStaticDeflection(tire, fz);
+  };
+  const TireModel& tire0 = tires_[0]->getModel();
+  const double r0 = tire0.vertical().unloaded_radius_m, d0 = calcStaticDeflection(tire0, fz), h0 = r0 - d0;
+  double dh = 0, wcz = 0;
+  for (int c = 0; c < n; ++c) {
+    dh += (cornerHeight(c) - h0) / n;
+    wcz += suspension(c / 2).calcWheelCentreInChassis(c % 2)[2] / n;
+  }
+  chassis_.setQToFitTranslation(s, Vec3(0, 0, road0 + r0 - d0 + dh - wcz));
+  system.realize(s, SimTK::Stage::Position);
+
+  std::vector<std::pair<std::string, SimTK::MobilizedBody>> bodies;
+  for (int c = 0; c < n; ++c)
+    for (const std::string& role : suspension(c / 2).bodyRoles())
+      bodies.push_back({cornerName(c) + "." + role, scene_->getBody(cornerName(c) + "." + role)});
+  double gap = 0;
+  AssemblyReport conReport;
+  bool copied = false;
+  // Axles that start from another template's assembly: a copy of the vehicle
+  // with those templates, its axle steering held at its initial angles.
+  WheeledVehicleParams cp = p_;
+  cp.forward_dynamics = "simbody";
+  for (int ax = 0; ax < numAxles(); ++ax) {
+    const std::string t = suspension(ax).getAssemblyTemplate();
+    if (t.empty()) continue;
+    cp.axles[ax].suspension.block["template"] = t;
+    copied = true;
+  }
+  if (copied) {
+    WheeledVehicle con(cp, *registry_);
+    for (const AxleSteering& a : axleSteering_)
+      con.addAxleSteering(a.name, a.axle,
+                          std::make_shared<HoldCommand>(a.command ? a.command->calcAt(s.getTime()).angle_rad
+                                                                  : a.initial_angle_rad));
+    // Steering plugins a scene file added through the registry (not through
+    // addAxleSteering) are held in the copy the same way, in scene order:
+    // without them the copy's knuckles assembled unsteered and the reduced
+    // vehicle started elsewhere than the same composition in C++.
+    for (const auto& plugin : scene_->getPlugins()) {
+      const auto* sp = dynamic_cast<const SteeringPlugin*>(plugin.get());
+      if (!sp || std::any_of(axleSteering_.begin(), axleSteering_.end(),
+                             [&](const AxleSteering& a) { return a.name == sp->name(); }))
+        continue;
+      const double angle = sp->isStateDriven() ? sp->getSteerBody().getDefaultAngle()
+                                               : sp->command().calcAt(s.getTime()).angle_rad;
+      con.updScene().addPlugin(std::make_unique<SteeringPlugin>(sp->name(), sp->chassisBody(), sp->knuckleBodies(),
+                                                                std::make_shared<HoldCommand>(angle), sp->spinAxis()));
+    }
+    const SimTK::State cs = con.makeInitialState(0.0, &conReport);
+    chassis_.setQ(s, con.chassis().getQ(cs));
+    for (int c = 0; c < n; ++c) {
+      const Suspension& mine = suspension(c / 2);
+      if (mine.getAssemblyTemplate().empty()) continue;
+      const double delta = steeringAngle(cs, con.chassis(), con.getScene().getBody(cornerName(c) + ".knuckle"),
+                                         mine.getSpinAxis(c % 2));
+      mine.setPositionFrom(s, c % 2, con.suspension(c / 2), cs, delta);
+    }
+    gap = conReport.initial_loop_gap_m;
+  }
+  std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex()};
+  for (int c = 0; c < n; ++c) {
+    locked.push_back(scene_->getBody(cornerName(c) + ".wheel").getMobilizedBodyIndex());
+    gap = std::max(gap, suspension(c / 2).calcLoopGap(s, c % 2));
+  }
+  for (auto mbx : steeringStateBodies(*scene_)) locked.push_back(mbx);  // keep delta at its initial value
+  assembleLoops(system, s, locked, bodies, gap, "vehicle", report);
+  if (copied && report) *report = conReport;  // the moves that made this configuration
+  // Moving forward with every body at the chassis velocity and the wheels rolling.
+  s.updU() = 0;
+  chassis_.setUToFitLinearVelocity(s, Vec3(speed, 0, 0));
+  system.realize(s, SimTK::Stage::Velocity);
+  // Free rolling: each wheel spins at its own heading speed over its rolling radius
+  // (assembly leaves a small toe on the knuckles, so headings differ slightly).
+  std::vector<double> spin(n);
+  for (int c = 0; c < n; ++c) {
+    const ContactKinematics k = tires_[c]->calcContact(s).kinematics;
+    spin[c] = k.vx_m_s / tires_[c]->getForceElement().getModel().calcRollingRadius(k.deflection_m);
+  }
+  for (int c = 0; c < n; ++c) scene_->getBody(cornerName(c) + ".wheel").setOneU(s, 0, spin[c]);
+  system.realize(s, SimTK::Stage::Velocity);
+  for (const TirePlugin* t : tires_) t->getForceElement().initializeRelaxationStates(s);
+  if (p_.forward_dynamics == "dense") {
+    useDenseRows(s);
+    system.realize(s, SimTK::Stage::Velocity);
+  }
+  return s;
+}
+
+const DoubleWishboneCorner& WheeledVehicle::corner(int c) const {
+  const Suspension& s = suspension(c / 2);
+  if (s.templateName() != "double_wishbone")
+    throw Error("vehicle: corner() is the constrained double wishbone's; corner '" + cornerName(c) + "' is " +
+                s.templateName() + " (reducedCorner() for double_wishbone_reduced)");
+  return static_cast<const DoubleWishboneSuspension&>(s).getCorner(c % 2);
+}
+
+const ReducedWishboneCorner& WheeledVehicle::reducedCorner(int c) const {
+  return suspensionAs<ReducedDoubleWishboneSuspension>(c / 2).getReducedCorner(c % 2);
+}
+
+bool WheeledVehicle::isReduced() const {
+  for (const Axle& a : axles_)
+    if (!dynamic_cast<const ReducedDoubleWishboneSuspension*>(a.suspension.get())) return false;
+  return true;
+}
+
+const DoubleWishboneParams& WheeledVehicle::cornerParams(int c) const {
+  return suspensionAs<DoubleWishboneSuspension>(c / 2).getCornerParams(c % 2);
+}
+
+double WheeledVehicle::suspensionAngle(const SimTK::State& s, int c) const {
+  return suspension(c / 2).getSuspensionCoordinate(s, c % 2);
+}
+
+SimTK::State WheeledVehicle::makeStateLike(const WheeledVehicle& other, const SimTK::State& os) const {
+  if (!isReduced())
+    throw Error("vehicle: makeStateLike() builds a reduced model's state; every axle must be double_wishbone_reduced");
+  const SimTK::MultibodySystem& system = scene_->getSystem();
+  const Scene& osc = other.getScene();
+  osc.getSystem().realize(os, SimTK::Stage::Velocity);
+  SimTK::State s = scene_->getDefaultState();
+  s.setTime(os.getTime());
+  chassis_.setQ(s, other.chassis().getQ(os));
+  chassis_.setU(s, other.chassis().getU(os));
+  for (int c = 0; c < numCorners(); ++c) {
+    const std::string n = cornerName(c);
+    const ReducedWishboneCorner& rc = reducedCorner(c);
+    const SimTK::MobilizedBody& ok = osc.getBody(n + ".knuckle");
+    const SimTK::UnitVec3 spin = suspension(c / 2).getSpinAxis(c % 2);
+    // (A.1) angle and its rate: x . f = -sin(delta), d/dt (x . f) = (w_K - w_C) . (f x x).
+    const SimTK::Vec3 x = other.chassis().getBodyRotation(os).x();
+    const SimTK::Vec3 f = ok.getBodyRotation(os) * spin.asVec3();
+    const double delta = std::asin(-SimTK::dot(x, f));
+    const double xfdot = SimTK::dot(ok.getBodyAngularVelocity(os) - other.chassis().getBodyAngularVelocity(os),
+                                    SimTK::cross(f, x));
+    const double sAng = other.suspensionAngle(os, c);
+    setReducedCornerPosition(s, rc, sAng, delta);
+    const double sRate = osc.getBody(n + ".lower_arm").getOneU(os, 0);
+    const double deltaRate = -xfdot / std::cos(delta);
+    rc.knuckle.setOneU(s, 0, sRate);
+    rc.knuckle.setOneU(s, 1, deltaRate);
+    rc.lower_arm.setOneU(s, 0, sRate);
+    rc.upper_arm.setOneU(s, 0, rc.loop->calcUpperArmAngle(sAng)[1] * sRate);
+    const SimTK::MobilizedBody& ow = osc.getBody(n + ".wheel");
+    rc.wheel.setOneQ(s, 0, ow.getOneQ(os, 0));
+    rc.wheel.setOneU(s, 0, ow.getOneU(os, 0));
+  }
+  // State-driven steer bodies (same plugins, same order) and z variables.
+  const auto mine = steeringStateBodies(*scene_), theirs = steeringStateBodies(osc);
+  if (mine.size() != theirs.size()) throw Error("vehicle makeStateLike: the vehicles have different steering plugins");
+  for (std::size_t i = 0; i < mine.size(); ++i) {
+    scene_->getMatter().getMobilizedBody(mine[i]).setOneQ(s, 0, osc.getMatter().getMobilizedBody(theirs[i]).getOneQ(os, 0));
+    scene_->getMatter().getMobilizedBody(mine[i]).setOneU(s, 0, osc.getMatter().getMobilizedBody(theirs[i]).getOneU(os, 0));
+  }
+  if (s.getNZ() != os.getNZ()) throw Error("vehicle makeStateLike: the vehicles have different z variables");
+  s.updZ() = os.getZ();
+  system.realize(s, SimTK::Stage::Position);
+  system.project(s, 1e-12);
+  if (p_.forward_dynamics == "dense") useDenseRows(s);
+  system.realize(s, SimTK::Stage::Velocity);
+  return s;
+}
+
+void WheeledVehicle::useDenseRows(SimTK::State& s) const {
+  if (!dense_) {
+    for (int ax = 0; ax < numAxles(); ++ax) {
+      ReducedDenseRows::Arm arm;
+      if (!suspension(ax).getDenseArm(0, &arm))
+        throw Error("vehicle: dense forward dynamics needs every axle's suspension template to have a dense "
+                    "formulation (double_wishbone_reduced); axle '" + p_.axles[ax].name + "' is " +
+                    suspension(ax).templateName());
+    }
+  }
+  const Scene& sc = *scene_;
+  std::vector<ReducedDenseRows::Arm> arms;
+  for (int c = 0; c < numCorners(); ++c) {
+    ReducedDenseRows::Arm arm;
+    suspension(c / 2).getDenseArm(c % 2, &arm);
+    arms.push_back(arm);
+  }
+  std::vector<ReducedDenseRows::Steer> steers;
+  std::vector<ReducedDenseRows::Speed> speeds;
+  const std::string why = " (forward_dynamics \"dense\" solves only time-commanded steering of the knuckles and "
+                          "speed holds on the chassis; use forward_dynamics \"simbody\")";
+  for (const auto& plugin : sc.getPlugins()) {
+    if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get())) {
+      if (st->isStateDriven()) throw Error("vehicle: steering plugin '" + plugin->name() + "' is state-driven" + why);
+      if (sc.getBody(st->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
+        throw Error("vehicle: steering plugin '" + plugin->name() + "' is not on the chassis" + why);
+      for (const std::string& k : st->knuckleBodies()) {
+        int c = 0;
+        while (c < numCorners() && cornerName(c) + ".knuckle" != k) ++c;
+        if (c == numCorners()) throw Error("vehicle: steering plugin '" + plugin->name() + "' steers '" + k + "', not a knuckle" + why);
+        if ((st->spinAxis().asVec3() - suspension(c / 2).getSpinAxis(c % 2).asVec3()).norm() > 1e-12)
+          throw Error("vehicle: steering plugin '" + plugin->name() + "' measures (A.1) about another spin axis than " + k +
+                      "'s" + why);
+        steers.push_back({reducedCorner(c).knuckle, st->sharedCommand()});
+      }
+    } else if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get())) {
+      if (sc.getBody(sp->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
+        throw Error("vehicle: speed hold '" + plugin->name() + "' is not on the chassis" + why);
+      const ReducedDenseRows* dense = dense_;
+      const int k = int(speeds.size());
+      sp->setDisabledForceSource([dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); });
+      speeds.push_back({chassis_, sp});
+    }
+  }
+  dense_->setRows(std::move(arms), std::move(steers), std::move(speeds));
+  const SimTK::MultibodySystem& system = sc.getSystem();
+  if (dense_->isActive(s)) return;
+  system.realize(s, SimTK::Stage::Instance);
+  if (s.getNUDotErr() != dense_->numRows())
+    throw Error("vehicle: the scene has " + std::to_string(s.getNUDotErr()) + " constraint rows, the dense path solves " +
+                std::to_string(dense_->numRows()) + why);
+  const SimTK::SimbodyMatterSubsystem& m = sc.getMatter();
+  for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(s);
+  dense_->setActive(s, true);
+}
+
+}  // namespace vdyn
