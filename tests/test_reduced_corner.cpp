@@ -317,7 +317,9 @@ TEST(ReducedDense, SameCh3TransientAsSimbodysRows) {
 TEST(ReducedDense, NeedsTheReducedModelAndTimeCommands) {
   WheeledVehicleParams p = params("constrained");
   p.forward_dynamics = "dense";
-  EXPECT_THROW(p.validate(), Error);
+  EXPECT_EQ(vdyn::test::errorOf([&] { WheeledVehicle car(p); }),
+            "vehicle forward_dynamics \"dense\" needs every axle's suspension template to have a dense formulation "
+            "(double_wishbone_reduced); axle 'front' is double_wishbone");
   const auto con = ch3Car("constrained", "appendix_a.json", true);
   SimTK::State s = con->makeInitialState(10.0);
   EXPECT_THROW(con->useDenseRows(s), Error);
