@@ -320,3 +320,56 @@ TEST(KinematicsReference, E90Tables) {
     EXPECT_LT(r.right.loop_residual, kTol);
   }
 }
+
+// The E90 data file's totals from its bodies (docs/bmw_e90.md, "Vehicle
+// totals"): each body where Chrono places it at design, both sides; the axle
+// loads by the moment balance about the contact points below the wheel centres.
+TEST(KinematicsReference, E90TotalsFromItsBodies) {
+  const nlohmann::json d = e90();
+  double m = 0.0, mx = 0.0, my = 0.0, mz = 0.0;
+  auto add = [&](double mass, const Vec3& p, bool both_sides) {
+    for (int k = 0; k < (both_sides ? 2 : 1); ++k) {
+      const double side = k == 0 ? 1.0 : -1.0;  // the second is the mirror image
+      m += mass, mx += mass * p[0], my += mass * side * p[1], mz += mass * p[2];
+    }
+  };
+  add(d.at("chassis").at("mass_kg").get<double>(), vec(d.at("chassis").at("cm_m")), false);
+  for (const char* axle : {"front", "rear"}) {
+    const nlohmann::json& a = d.at(axle);
+    const nlohmann::json& h = a.at("hardpoints_m");
+    for (const auto& [name, body] : a.at("bodies").items()) {
+      if (!body.is_object()) continue;
+      const std::string at = body.at("at").get<std::string>();
+      Vec3 p{};
+      if (at.rfind("midpoint ", 0) == 0) {
+        const std::string pair = at.substr(9);
+        const Vec3 p1 = vec(h.at(pair.substr(0, pair.find(' ')))), p2 = vec(h.at(pair.substr(pair.find(' ') + 1)));
+        p = {0.5 * (p1[0] + p2[0]), 0.5 * (p1[1] + p2[1]), 0.5 * (p1[2] + p2[2])};
+      } else {
+        p = vec(h.at(at));
+      }
+      add(body.at("mass_kg").get<double>(), p, true);
+    }
+    const Vec3 spindle = vec(h.at("SPINDLE"));
+    add(a.at("wheel").at("mass_kg").get<double>(), spindle, true);
+    add(a.at("tire_tmeasy").at("mass_kg").get<double>(), spindle, true);
+    const nlohmann::json& arb = a.at("anti_roll_bar");
+    const Vec3 loc = vec(arb.at("location_m"));
+    add(arb.at("arm_mass_kg").get<double>(), {loc[0], -0.5 * arb.at("arm_reach_m").get<double>(), loc[2]}, true);
+  }
+  add(d.at("steering").at("rack_mass_kg").get<double>(), vec(d.at("steering").at("location_m")), false);
+  const nlohmann::json& t = d.at("totals_tmeasy");
+  EXPECT_NEAR(m, t.at("mass_kg").get<double>(), 1e-9);
+  const Vec3 cm{mx / m, my / m, mz / m}, cm_file = vec(t.at("cm_m"));
+  for (int i = 0; i < 3; ++i) EXPECT_NEAR(cm[i], cm_file[i], 1e-11);
+  const double g = t.at("gravity_m_per_s2").get<double>(), L = d.at("wheelbase_m").get<double>();
+  const double x_front = vec(d.at("front").at("hardpoints_m").at("SPINDLE"))[0];
+  const double x_rear = vec(d.at("rear").at("hardpoints_m").at("SPINDLE"))[0];
+  EXPECT_NEAR(x_front - x_rear, L, 1e-12);
+  const double front = m * g * (cm[0] - x_rear) / L, rear = m * g * (x_front - cm[0]) / L;
+  EXPECT_NEAR((front + rear) / (m * g), 1.0, 1e-12);
+  EXPECT_NEAR(front, t.at("front_axle_load_N").get<double>(), 1e-6);
+  EXPECT_NEAR(rear, t.at("rear_axle_load_N").get<double>(), 1e-6);
+  std::printf("E90 (TMeasy): mass %.6f kg, c.m. (%.6f, %.6f, %.6f) m, axle loads front %.4f N, rear %.4f N\n", m, cm[0],
+              cm[1], cm[2], front, rear);
+}
