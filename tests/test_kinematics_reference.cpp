@@ -204,6 +204,22 @@ TEST(KinematicsReference, RackVerticalKingpinClosedForm) {
   }
 }
 
+// Knuckle steering (vdyn's (A.1)) on the vertical kingpin: the wheel centre
+// turns about the kingpin by the steer angle, camber stays zero.
+TEST(KinematicsReference, KnuckleSteerVerticalKingpinClosedForm) {
+  const kr::DoubleWishboneHardpoints hp = parallelWishbone();
+  const double ky = hp.lca_u[1], wy = hp.spindle[1] - ky;  // kingpin at x = 0, y = ky
+  for (double delta : {-0.4, -0.05, 0.0, 0.2, 0.4}) {
+    const kr::WheelKinematics k = kr::doubleWishboneKinematicsKnuckleSteer(hp, 0.0, delta);
+    EXPECT_NEAR(k.steer_rad, delta, kTol);
+    EXPECT_NEAR(k.camber_rad, 0.0, kTol);
+    EXPECT_NEAR(k.wheel_centre_m[0], -wy * std::sin(delta), kTol);
+    EXPECT_NEAR(k.wheel_centre_m[1], ky + wy * std::cos(delta), kTol);
+    EXPECT_NEAR(k.dz_m, 0.0, kTol);
+    EXPECT_LT(k.loop_residual, kTol);
+  }
+}
+
 // Three parallel equal trailing links and a lateral Panhard rod: in heave the
 // axle translates by (dx, dy, z) with dx = Lp dy / L and
 // (1 + Lp^2 / L^2) dy^2 - 2 Lp dy + z^2 = 0 (the small root).
@@ -253,6 +269,7 @@ TEST(KinematicsReference, JacobiansMatchCentralDifferences) {
   EXPECT_LT(kr::macphersonJacobianError(e90Front(), -0.07, -0.02), 1e-8);
   EXPECT_LT(kr::doubleWishboneJacobianError(e90Rear(), -0.04, 0.0), 1e-8);
   EXPECT_LT(kr::doubleWishboneJacobianError(parallelWishbone(), 0.03, 0.05), 1e-8);
+  EXPECT_LT(kr::doubleWishboneKnuckleSteerJacobianError(e90Rear(), 0.05, 0.3), 1e-8);
   kr::SolidAxleHardpoints hp = panhardAxle();
   EXPECT_LT(kr::solidAxleJacobianError(hp, 0.03, -0.02), 1e-8);
 }

@@ -202,18 +202,26 @@ private:
   double z_ = 0.0, rack_ = 0.0;
 };
 
+// With knuckle steering (vdyn's (A.1)) the tie-rod row is x . s_left + sin(steer)
+// = 0 and the second input is the steer angle.
 class DoubleWishboneLoop : public Loop {
 public:
-  explicit DoubleWishboneLoop(const DoubleWishboneHardpoints& hp)
-      : hp_(hp), lca_(makeArm(hp.lca_f, hp.lca_b, hp.lca_u, "the LCA axis LCA_F-LCA_B")),
+  DoubleWishboneLoop(const DoubleWishboneHardpoints& hp, bool knuckle_steer)
+      : hp_(hp), knuckle_(knuckle_steer),
+        lca_(makeArm(hp.lca_f, hp.lca_b, hp.lca_u, "the LCA axis LCA_F-LCA_B")),
         uca_(makeArm(hp.uca_f, hp.uca_b, hp.uca_u, "the UCA axis UCA_F-UCA_B")),
-        tierod_(makeLink(hp.tierod_c, hp.tierod_u, "the tie rod TIEROD_C-TIEROD_U")) {}
+        tierod_(knuckle_steer ? Link{{0, 0, 0}, {0, 0, 0}, 1.0}
+                              : makeLink(hp.tierod_c, hp.tierod_u, "the tie rod TIEROD_C-TIEROD_U")) {
+    const double side = sideOf(hp.spindle);
+    spin_left_ = scale(side, spinAxisOutward(hp.camber_rad, hp.toe_in_rad, side));
+  }
+  explicit DoubleWishboneLoop(const DoubleWishboneHardpoints& hp) : DoubleWishboneLoop(hp, false) {}
   int arms() const override { return 2; }
-  void setInputs(double z, double rack) override { z_ = z, rack_ = rack; }
+  void setInputs(double z, double second) override { z_ = z, second_ = second; }
   void residual(const State& s, double* r) const override {
     ballResidual(s, lca_, 0, hp_.lca_u, r);
     ballResidual(s, uca_, 1, hp_.uca_u, r + 3);
-    r[6] = linkResidual(s, tierod_, {0, rack_, 0});
+    r[6] = knuckle_ ? s.dir(spin_left_)[0] + std::sin(second_) : linkResidual(s, tierod_, {0, second_, 0});
     r[7] = s.point(hp_.spindle)[2] - (hp_.spindle[2] + z_);
   }
   void jacobian(const State& s, double* J) const override {
@@ -221,20 +229,32 @@ public:
     std::fill(J, J + n * n, 0.0);
     ballJacobian(s, lca_, 0, hp_.lca_u, J, n, 0);
     ballJacobian(s, uca_, 1, hp_.uca_u, J, n, 3);
-    linkJacobian(s, tierod_, {0, rack_, 0}, J, n, 6);
+    if (knuckle_) {
+      const Vec3 a = s.dir(spin_left_);  // d(x . a) = dphi . (a x x_hat)
+      J[6 * n + 0] = 0.0, J[6 * n + 1] = a[2], J[6 * n + 2] = -a[1];
+    } else {
+      linkJacobian(s, tierod_, {0, second_, 0}, J, n, 6);
+    }
     heightJacobian(s, hp_.spindle, J, n, 7);
   }
   void residualRackDerivative(const State& s, double* dr) const override {
     std::fill(dr, dr + size(), 0.0);
-    const Vec3 u = sub(s.point(tierod_.r_C), add(tierod_.c, {0, rack_, 0}));
+    if (knuckle_) return;
+    const Vec3 u = sub(s.point(tierod_.r_C), add(tierod_.c, {0, second_, 0}));
     dr[6] = -u[1] / tierod_.L;
   }
 
 private:
   DoubleWishboneHardpoints hp_;
+  bool knuckle_;
   Arm lca_, uca_;
   Link tierod_;
-  double z_ = 0.0, rack_ = 0.0;
+  Vec3 spin_left_{};
+  double z_ = 0.0, second_ = 0.0;
+};
+
+struct KnuckleSteeredWishbone : DoubleWishboneLoop {
+  explicit KnuckleSteeredWishbone(const DoubleWishboneHardpoints& hp) : DoubleWishboneLoop(hp, true) {}
 };
 
 class SolidAxleLoop : public Loop {
@@ -493,6 +513,19 @@ RackSteer rackSteer(const MacPhersonHardpoints& right, double pinion_rad, double
 RackSteer rackSteer(const DoubleWishboneHardpoints& right, double pinion_rad, double c_m_per_rad,
                     double wheel_travel_m) {
   return rackSteerOf<DoubleWishboneHardpoints, DoubleWishboneLoop>(right, pinion_rad, c_m_per_rad, wheel_travel_m);
+}
+
+WheelKinematics doubleWishboneKinematicsKnuckleSteer(const DoubleWishboneHardpoints& hp, double wheel_travel_m,
+                                                     double steer_rad) {
+  WheelKinematics w = cornerKinematics<DoubleWishboneHardpoints, KnuckleSteeredWishbone>(hp, wheel_travel_m, steer_rad);
+  w.dsteer_drack_rad_per_m = 0.0;
+  return w;
+}
+
+double doubleWishboneKnuckleSteerJacobianError(const DoubleWishboneHardpoints& hp, double wheel_travel_m,
+                                               double steer_rad, double h) {
+  KnuckleSteeredWishbone loop(hp);
+  return jacobianError(loop, wheel_travel_m, steer_rad, h);
 }
 
 double macphersonJacobianError(const MacPhersonHardpoints& hp, double wheel_travel_m, double rack_travel_m, double h) {

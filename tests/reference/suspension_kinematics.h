@@ -130,6 +130,16 @@ WheelKinematics macphersonKinematics(const MacPhersonHardpoints& hp, double whee
 WheelKinematics doubleWishboneKinematics(const DoubleWishboneHardpoints& hp, double wheel_travel_m,
                                          double rack_travel_m = 0.0);
 
+/// Double wishbone steered at the knuckle as vdyn's App. A corner is (its
+/// (A.1), docs/equations.md "Steering"): no tie rod (tierod_* ignored); the
+/// spin axis s_left (pointing left) is held at x . s_left = -sin(steer_rad).
+/// Steps the steer angle by at most 0.01 rad from design.
+/// dsteer_drack_rad_per_m is 0. steer_rad is the heading angle defined above
+/// (atan2 of the spin axis' projection), which equals (A.1)'s angle only
+/// while the spin axis stays in the chassis x-y plane (zero camber).
+WheelKinematics doubleWishboneKinematicsKnuckleSteer(const DoubleWishboneHardpoints& hp, double wheel_travel_m,
+                                                     double steer_rad);
+
 struct AxleKinematics {
   WheelKinematics right, left;
   /// Axle roll: inclination of the wheel-centre line (right to left centre)
@@ -173,6 +183,8 @@ double macphersonJacobianError(const MacPhersonHardpoints& hp, double wheel_trav
                                double rack_travel_m, double h = 1e-6);
 double doubleWishboneJacobianError(const DoubleWishboneHardpoints& hp, double wheel_travel_m,
                                    double rack_travel_m, double h = 1e-6);
+double doubleWishboneKnuckleSteerJacobianError(const DoubleWishboneHardpoints& hp, double wheel_travel_m,
+                                               double steer_rad, double h = 1e-6);
 double solidAxleJacobianError(const SolidAxleHardpoints& hp, double travel_right_m,
                               double travel_left_m, double h = 1e-6);
 
