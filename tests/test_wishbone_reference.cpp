@@ -12,7 +12,7 @@
 #include <cstdio>
 
 #include "reference/suspension_kinematics.h"
-#include "vdyn/vehicles/fourws.h"
+#include "vdyn/vehicles/wheeled_vehicle.h"
 #include "vdyn/vehicles/reduced_wishbone.h"
 
 namespace kr = vdyn::kinematics_reference;
@@ -24,9 +24,9 @@ kr::Vec3 arr(const SimTK::Vec3& v) { return {v[0], v[1], v[2]}; }
 }  // namespace
 
 TEST(WishboneReference, AppendixACornersMatchTheReference) {
-  vdyn::FourWsParams p = vdyn::FourWsParams::fromFile("appendix_a.json");
-  p.corner_model = "reduced";
-  const vdyn::FourWsVehicle car(p);
+  vdyn::WheeledVehicleParams p = vdyn::WheeledVehicleParams::fromFile("appendix_a.json");
+  p.setSuspensionTemplate("double_wishbone_reduced");
+  const vdyn::WheeledVehicle car(p);
   const SimTK::MultibodySystem& sys = car.getScene().getSystem();
   SimTK::State s = car.makeInitialState();
   double worst_m = 0.0, worst_axis = 0.0;
@@ -60,9 +60,9 @@ TEST(WishboneReference, AppendixACornersMatchTheReference) {
           worst_m = std::max(worst_m, std::fabs(k.wheel_centre_m[i] - X_CK.p()[i]));
           worst_axis = std::max(worst_axis, std::fabs(k.spin_axis_out[i] - out[i]));
           EXPECT_NEAR(k.wheel_centre_m[i], X_CK.p()[i], 1e-11)
-              << vdyn::cornerName(c) << " s " << sq << " delta " << delta << " axis " << i;
+              << car.cornerName(c) << " s " << sq << " delta " << delta << " axis " << i;
           EXPECT_NEAR(k.spin_axis_out[i], out[i], 1e-11)
-              << vdyn::cornerName(c) << " s " << sq << " delta " << delta << " axis " << i;
+              << car.cornerName(c) << " s " << sq << " delta " << delta << " axis " << i;
         }
         EXPECT_NEAR(-side * k.spin_axis_out[0], std::sin(delta), 1e-11);  // (A.1): x . s_left = -sin(delta)
         EXPECT_LT(k.loop_residual, 1e-12);
