@@ -2,6 +2,7 @@
 #include "vdyn/vehicles/suspension.h"
 
 #include "vdyn/templates/double_wishbone.h"
+#include "vdyn/templates/macpherson_strut.h"
 
 #include "vdyn/plugins/builtin.h"
 
@@ -29,6 +30,7 @@ std::unique_ptr<Suspension> makeSuspension(const PluginRegistry& registry, const
 
 void registerSuspensionTemplates(PluginRegistry& registry) {
   registerDoubleWishboneTemplates(registry);
+  registerMacPhersonStrut(registry);
 }
 
 const PluginRegistry& vehiclePlugins() {
