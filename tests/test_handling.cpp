@@ -650,3 +650,26 @@ TEST(ClosedLoop, Ch8JTurnGainsDampingByLinearisationAndByLogDecrement) {
   EXPECT_NEAR(zetaSim, zetaLin, 0.003);
  }
 }
+
+// The BMW E90 (bmw_e90.json: MacPherson strut front, double wishbone with tie
+// rods rear, chassis c.m. off the data frame's origin): the static tire loads
+// carry its weight, and the axle loads are those of the moment balance over
+// the contact points at rest.
+TEST(VehicleReport, E90StaticLoadsAndMomentBalance) {
+  const Json scene = {{"name", "report_e90"},
+                      {"vehicle", {{"type", "wheeled"}, {"data", "bmw_e90.json"}}},
+                      {"analysis", {{"type", "vehicle_report"}}}};
+  const VehicleReport r =
+      makeVehicleReport(SceneDescription::fromJson(scene, "", standardRegistry()), {-0.08, 0.0, 0.08});
+  // 1442.1 kg chassis, two front corners of 96.42 kg, two rear of 122.93 kg (bmw_e90.json).
+  EXPECT_NEAR(r.weight_N, (1442.1 + 2 * (2.72 + 28.14 + 65.562478) + 2 * (23.965 + 5.813 + 25.45 + 67.705)) * 9.81,
+              1e-6);
+  EXPECT_NEAR(r.total_load_N, r.weight_N, 1e-9 * r.weight_N);
+  EXPECT_NEAR(r.front_axle_load_N + r.rear_axle_load_N, r.total_load_N, 1e-9 * r.total_load_N);
+  EXPECT_NEAR(r.front_axle_load_N, r.front_axle_load_from_moments_N, 1e-6 * r.front_axle_load_N);
+  EXPECT_NEAR(r.corner_loads_N[0].second, r.corner_loads_N[1].second, 0.01 * r.corner_loads_N[0].second);
+  ASSERT_EQ(r.kinematics.size(), 2u);
+  std::printf("e90: loads %.2f %.2f %.2f %.2f N, front %.3f N against %.3f N from the moments, weight %.3f N\n",
+              r.corner_loads_N[0].second, r.corner_loads_N[1].second, r.corner_loads_N[2].second,
+              r.corner_loads_N[3].second, r.front_axle_load_N, r.front_axle_load_from_moments_N, r.weight_N);
+}

@@ -1,5 +1,7 @@
 #include "vdyn/vehicles/double_wishbone.h"
 
+#include <cmath>
+
 #include "vdyn/core/fields.h"
 
 #include "wishbone_corner.h"
@@ -67,6 +69,8 @@ void DoubleWishboneParams::validate(const std::string& w) const {
   requirePositive(spring_stiffness_N_per_m, w + ".spring.stiffness_N_per_m");
   requireNonNegative(damper_N_s_per_m, w + ".spring.damping_N_s_per_m");
   requirePositive(spring_free_length_m, w + ".spring.free_length_m");
+  if (tie_rod != "none" && tie_rod != "chassis")
+    throw Error(w + ".tie_rod must be \"none\" or \"chassis\", got \"" + tie_rod + "\"");
 }
 
 const FieldTable<DoubleWishboneParams>& DoubleWishboneParams::fields() {
@@ -127,6 +131,74 @@ DoubleWishboneParams DoubleWishboneParams::fromParams(const ParamReader& r) {
   return p;
 }
 
+namespace {
+/// A body of the hardpoint form: mass, inertia (about its c.m., chassis axes)
+/// and its c.m. in the chassis frame.
+RigidBodyParams hardpointBody(const ParamReader& r, Vec3* com) {
+  RigidBodyParams b;
+  b.mass_kg = r.number("mass_kg");
+  b.inertia_kg_m2 = r.vec3("inertia_kg_m2");
+  b.validate(r.where());
+  *com = r.vec3("com_m");
+  return b;
+}
+}  // namespace
+
+DoubleWishboneParams DoubleWishboneParams::fromHardpoints(const ParamReader& r) {
+  DoubleWishboneParams p;
+  const ParamReader h = r.child("hardpoints_m");
+  const Vec3 lf = h.vec3("lca_front"), lb = h.vec3("lca_back"), lu = h.vec3("lca_upright");
+  const Vec3 uf = h.vec3("uca_front"), ub = h.vec3("uca_back"), uu = h.vec3("uca_upright");
+  const Vec3 spindle = h.vec3("spindle");
+  const ParamReader b = r.child("bodies");
+  Vec3 cl, cu, ck;
+  p.lower_arm = hardpointBody(b.child("lower_arm"), &cl);
+  p.upper_arm = hardpointBody(b.child("upper_arm"), &cu);
+  p.knuckle = hardpointBody(b.child("knuckle"), &ck);
+  p.knuckle.com_m = ck - spindle;  // the knuckle frame's origin is the wheel centre
+  p.wheel = RigidBodyParams::fromParams(b.child("wheel"));
+  auto revolute = [](const Vec3& a, const Vec3& axisPoint, const Vec3& com) {
+    JointParams j;
+    j.revolute = true;
+    j.parent_point_m = a;
+    j.parent_axis_point_m = axisPoint;
+    j.child_point_m = a - com;
+    j.child_axis_point_m = axisPoint - com;
+    return j;
+  };
+  auto ball = [](const Vec3& x, const Vec3& parentOrigin, const Vec3& childOrigin) {
+    JointParams j;
+    j.parent_point_m = x - parentOrigin;
+    j.child_point_m = x - childOrigin;
+    return j;
+  };
+  p.lower_pivot = revolute(lf, lb, cl);
+  p.lower_ball = ball(lu, cl, spindle);
+  p.upper_ball = ball(uu, cu, spindle);
+  p.upper_pivot = revolute(uf, ub, cu);
+  const double camber = r.numberOr("camber_rad", 0), toe = r.numberOr("toe_in_rad", 0);
+  // The right wheel's spin axis pointing left (+eta) from camber (+ top out) and toe (+ in).
+  p.wheel_spin_axis = Vec3(-std::cos(camber) * std::sin(toe), std::cos(camber) * std::cos(toe), std::sin(camber));
+  const ParamReader s = r.child("spring");
+  p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
+  p.damper_N_s_per_m = s.number("damping_N_s_per_m");
+  p.spring_free_length_m = s.number("free_length_m");
+  p.spring_chassis_point_m = h.vec3("spring_chassis");
+  p.spring_arm_point_m = h.vec3("spring_arm") - cl;
+  if (h.has("damper_chassis") || h.has("damper_arm")) {
+    p.separate_damper = true;
+    p.damper_chassis_point_m = h.vec3("damper_chassis");
+    p.damper_arm_point_m = h.vec3("damper_arm") - cl;
+  }
+  p.tie_rod = r.stringOr("tie_rod", "none");
+  if (p.tie_rod == "chassis") {
+    p.tierod_chassis_point_m = h.vec3("tierod_chassis");
+    p.tierod_knuckle_point_m = h.vec3("tierod_upright") - spindle;
+  }
+  p.validate(r.where());
+  return p;
+}
+
 DoubleWishboneParams DoubleWishboneParams::mirrored() const {
   auto point = [](const Vec3& v) { return Vec3(v[0], -v[1], v[2]); };
   auto axial = [](const Vec3& v) { return Vec3(-v[0], v[1], -v[2]); };  // -M v for M = diag(1,-1,1)
@@ -148,6 +220,11 @@ DoubleWishboneParams DoubleWishboneParams::mirrored() const {
   m.wheel_spin_axis = axial(wheel_spin_axis);
   m.spring_chassis_point_m = point(spring_chassis_point_m);
   m.spring_arm_point_m = point(spring_arm_point_m);
+  m.damper_chassis_point_m = point(damper_chassis_point_m);
+  m.damper_arm_point_m = point(damper_arm_point_m);
+  m.tierod_chassis_point_m = point(tierod_chassis_point_m);
+  m.tierod_knuckle_point_m = point(tierod_knuckle_point_m);
+  for (RigidBodyParams* b : {&m.lower_arm, &m.knuckle, &m.upper_arm, &m.wheel}) b->com_m = point(b->com_m);
   return m;
 }
 
@@ -157,7 +234,11 @@ Vec3 wheelCentreInChassis(const DoubleWishboneParams& p) {
 }
 
 SimTK::Body::Rigid makeRigidBody(const RigidBodyParams& b) {
-  return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
+  if (b.com_m == Vec3(0))
+    return SimTK::Body::Rigid(SimTK::MassProperties(b.mass_kg, Vec3(0), SimTK::Inertia(b.inertia_kg_m2)));
+  // Simbody takes the inertia about the body origin.
+  return SimTK::Body::Rigid(SimTK::MassProperties(
+      b.mass_kg, b.com_m, SimTK::Inertia(b.inertia_kg_m2).shiftFromMassCenter(b.com_m, b.mass_kg)));
 }
 
 DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& chassis,
@@ -170,6 +251,11 @@ DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& cha
   // The loop cut at the upper ball (joint 3), closed by a constraint.
   c.upper_ball = SimTK::Constraint::Ball(c.upper_arm, p.upper_ball.parent_point_m, c.knuckle,
                                          p.upper_ball.child_point_m);
+  if (p.tie_rod == "chassis") {
+    const Vec3 knuckle0 = wheelCentreInChassis(p);  // the knuckle frame's origin in the chassis at design
+    c.tie_rod = SimTK::Constraint::Rod(chassis, p.tierod_chassis_point_m, c.knuckle, p.tierod_knuckle_point_m,
+                                       (knuckle0 + p.tierod_knuckle_point_m - p.tierod_chassis_point_m).norm());
+  }
   return c;
 }
 

@@ -41,8 +41,11 @@ void buildWishboneCorner(Scene& scene, SimTK::MobilizedBody& chassis, const Doub
   c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
                                                 p.spring_arm_point_m, p.spring_stiffness_N_per_m,
                                                 p.spring_free_length_m);
-  c.damper = SimTK::Force::TwoPointLinearDamper(scene.updForces(), chassis, p.spring_chassis_point_m, c.lower_arm,
-                                                p.spring_arm_point_m, p.damper_N_s_per_m);
+  c.damper = p.separate_damper
+                 ? SimTK::Force::TwoPointLinearDamper(scene.updForces(), chassis, p.damper_chassis_point_m,
+                                                      c.lower_arm, p.damper_arm_point_m, p.damper_N_s_per_m)
+                 : SimTK::Force::TwoPointLinearDamper(scene.updForces(), chassis, p.spring_chassis_point_m,
+                                                      c.lower_arm, p.spring_arm_point_m, p.damper_N_s_per_m);
   scene.addBody(prefix + "lower_arm", c.lower_arm);
   scene.addBody(prefix + "knuckle", c.knuckle);
   scene.addBody(prefix + "upper_arm", c.upper_arm);

@@ -332,6 +332,13 @@ class VehicleReportAnalysis : public Analysis {
                    {"weight_N", rep.weight_N},
                    {"chassis_origin_height_m", rep.chassis_origin_height_m},
                    {"com_height_m", rep.com_height_m}};
+    if (!rep.axle_contact_x_m.empty()) {
+      Json x = Json::object();
+      for (const auto& [n, v] : rep.axle_contact_x_m) x[n] = v;
+      res.summary["com_x_m"] = rep.com_x_m;
+      res.summary["axle_contact_x_m"] = x;
+      if (rep.axle_contact_x_m.size() == 2) res.summary["front_axle_load_from_moments_N"] = rep.front_axle_load_from_moments_N;
+    }
     if (!rep.added_plugins.empty() || !rep.replaced_plugins.empty())
       res.summary["plugins"] = {{"replaced", rep.replaced_plugins}, {"added", rep.added_plugins}};
     for (const auto& [axle, pts] : rep.kinematics) {

@@ -218,11 +218,36 @@ VehicleReport makeWheeledReport(const HandlingScene& h, const std::vector<double
     rep.total_load_N += fz;
   }
   rep.weight_N = car.totalMass() * params.gravity_m_per_s2;
+  rep.com_x_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[0];
+  for (int ax = 0; ax < car.numAxles(); ++ax) {
+    double fx = 0, f = 0;
+    for (int side = 0; side < 2; ++side) {
+      const TireContact k = car.tire(2 * ax + side).calcContact(s);
+      fx += k.forces.fz_N * k.p_GC[0];
+      f += k.forces.fz_N;
+    }
+    rep.axle_contact_x_m.push_back({params.axles[ax].name, fx / f});
+  }
+  if (car.numAxles() == 2) {
+    const double xf = rep.axle_contact_x_m[0].second, xr = rep.axle_contact_x_m[1].second;
+    rep.front_axle_load_from_moments_N = rep.total_load_N * (rep.com_x_m - xr) / (xf - xr);
+  }
   rep.chassis_origin_height_m = car.chassis().getBodyOriginLocation(s)[2] - road;
   rep.com_height_m = sc.getMatter().calcSystemMassCenterLocationInGround(s)[2] - road;
   const double y0 = car.chassis().getBodyOriginLocation(s)[1];
   for (int ax = 0; ax < car.numAxles(); ++ax) {
-    SuspensionCorner k = cornerOf(car.cornerName(2 * ax), car.corner(2 * ax));
+    KinematicCorner kc;
+    if (!car.suspension(ax).getKinematicCorner(0, &kc))
+      throw Error("vehicle_report: suspension template '" + car.suspension(ax).templateName() + "' of axle '" +
+                  params.axles[ax].name + "' has no kinematics sweep (use its constrained template)");
+    SuspensionCorner k;
+    k.name = car.cornerName(2 * ax);
+    k.lower_arm = kc.travel_body;
+    k.free = kc.free;
+    k.knuckle = kc.knuckle;
+    k.wheel = kc.wheel;
+    k.spring = kc.spring;
+    k.spin_axis_W = car.suspension(ax).getSpinAxis(0);
     k.centre_plane_y_m = y0;
     rep.kinematics.push_back({params.axles[ax].name, calcSuspensionKinematics(sc, s, k, travels, road)});
   }

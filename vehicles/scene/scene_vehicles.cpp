@@ -32,18 +32,18 @@ class WheeledSceneVehicle : public Vehicle {
     attachments_["wheels"] = {{"chassis", "chassis"}, {"wheels", wheels}};
     for (int ax = 0; ax < car_.numAxles(); ++ax) {
       const std::string r = car_.cornerName(2 * ax), l = car_.cornerName(2 * ax + 1);
-      attachments_[car_.params().axles[ax].name + "_axle"] = {
-          {"chassis", "chassis"},
-          {"knuckles", r + ".knuckle," + l + ".knuckle"},
-          {"spin_axis", axisText(car_.suspension(ax).getSpinAxis(0))}};
+      // An axle whose knuckles a tie rod holds offers no knuckles to steer.
+      Attachment a = {{"chassis", "chassis"}, {"spin_axis", axisText(car_.suspension(ax).getSpinAxis(0))}};
+      if (car_.suspension(ax).isSteerable()) a["knuckles"] = r + ".knuckle," + l + ".knuckle";
+      attachments_[car_.params().axles[ax].name + "_axle"] = a;
     }
     for (int c = 0; c < car_.numCorners(); ++c) {
       const std::string n = car_.cornerName(c);
       attachments_[n] = {{"chassis", "chassis"},
                          {"wheel", n + ".wheel"},
                          {"knuckle", n + ".knuckle"},
-                         {"knuckles", n + ".knuckle"},
                          {"spin_axis", axisText(car_.suspension(c / 2).getSpinAxis(c % 2))}};
+      if (car_.suspension(c / 2).isSteerable()) attachments_[n]["knuckles"] = n + ".knuckle";
     }
   }
 

@@ -70,7 +70,7 @@ std::vector<AxleParams> readAxles(const ParamReader& r, const PluginRegistry& re
     ax.suspension.block = sb.json();
     ax.suspension.where = sb.where();
     const std::unique_ptr<Suspension> susp = makeSuspension(registry, sb);
-    ax.wheel_centre_x_m = susp->calcWheelCentreInChassis(0)[0];
+    ax.wheel_centre_x_m = susp->calcWheelCentreInChassis(0)[0];  // order only: any common frame
     if (a.has("tire")) {
       const ParamReader own = a.child("tire");
       ax.tire = r.has("tire") ? TireChoice::fromParams(r.child("tire"), &own) : TireChoice::fromParams(own);
@@ -102,8 +102,14 @@ const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
   using P = WheeledVehicleParams;
   static const auto t =
       FieldTable<P>()
-          .custom("chassis", "-", "required", "rigid body: mass_kg, inertia_kg_m2 [3] (principal, about the c.m.)",
-                  [](const ParamReader& r, P& p) { p.chassis = RigidBodyParams::fromParams(r.child("chassis")); })
+          .custom("chassis", "-", "required",
+                  "rigid body: mass_kg, inertia_kg_m2 [3] (principal, about the c.m.), com_m (the c.m. in the data's "
+                  "chassis frame, default [0 0 0]: the chassis outputs refer to the c.m.)",
+                  [](const ParamReader& r, P& p) {
+                    const ParamReader c = r.child("chassis");
+                    p.chassis = RigidBodyParams::fromParams(c);
+                    p.chassis_com_m = c.vec3Or("com_m", SimTK::Vec3(0));
+                  })
           .custom("tire", "-", "none",
                   "every axle's tire unless it has its own: {\"plugin\": gim|fiala|linear|magic_formula|..., "
                   "\"params\": {the kind's 'params: ...' keys (vdyn list gim)}}",
@@ -151,11 +157,14 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
     const AxleParams& ap = p_.axles[ai];
     axles_.push_back({ap.suspension.create(registry)});
     Suspension& susp = *axles_.back().suspension;
+    if (p_.chassis_com_m != SimTK::Vec3(0)) susp.shiftChassisFrame(-p_.chassis_com_m);
     const std::string prefixes[2] = {ap.prefixes[0] + ".", ap.prefixes[1] + "."};
     susp.build(sc, chassis_, prefixes, [&](int side) {
       const std::string& n = ap.prefixes[side];
-      const PluginSpec spec = ap.tire.makeSpec("tire_" + n, prefixes[side] + "wheel",
-                                               Json{{"side", side == 0 ? "right" : "left"}});
+      Json entry{{"side", side == 0 ? "right" : "left"}};
+      const SimTK::Vec3 spin = susp.getSpinAxis(side).asVec3();  // in the wheel frame (its axes the knuckle's at q = 0)
+      if (spin != SimTK::Vec3(0, 1, 0)) entry["spin_axis"] = {spin[0], spin[1], spin[2]};
+      const PluginSpec spec = ap.tire.makeSpec("tire_" + n, prefixes[side] + "wheel", entry);
       const auto* tire = dynamic_cast<const TirePlugin*>(
           &sc.addPlugin(registry.create(PluginKind::ForceElement, ap.tire.plugin, spec, ap.tire.where + ".plugin")));
       if (!tire) throw Error(ap.tire.where + ".plugin: '" + ap.tire.plugin + "' is not a tire plugin");
@@ -201,6 +210,12 @@ int WheeledVehicle::axleIndex(const std::string& name) const {
   return -1;
 }
 
+void WheeledVehicle::requireSteerable(int axle, const std::string& plugin) const {
+  if (!suspension(axle).isSteerable())
+    throw Error("vehicle: steering plugin '" + plugin + "' steers axle '" + p_.axles[axle].name +
+                "', whose knuckles its suspension's tie rods hold (tie_rod \"chassis\")");
+}
+
 void WheeledVehicle::throwNotTemplate(int axle, const char* what) const {
   throw Error("vehicle axle '" + p_.axles.at(axle).name + "' has suspension template '" +
               suspension(axle).templateName() + "', not the one this needs (" + what + ")");
@@ -209,6 +224,7 @@ void WheeledVehicle::throwNotTemplate(int axle, const char* what) const {
 const SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, const std::string& axle,
                                                       std::shared_ptr<const SteeringCommand> command) {
   const int ax = axleIndex(axle);
+  requireSteerable(ax, name);
   axleSteering_.push_back({name, axle, command, 0.0});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{cornerName(2 * ax) + ".knuckle", cornerName(2 * ax + 1) + ".knuckle"},
@@ -219,6 +235,7 @@ const SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, c
 SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, const std::string& axle,
                                                 const SteeringStateSpec& state) {
   const int ax = axleIndex(axle);
+  requireSteerable(ax, name);
   axleSteering_.push_back({name, axle, nullptr, state.initial_angle_rad});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{cornerName(2 * ax) + ".knuckle", cornerName(2 * ax + 1) + ".knuckle"},

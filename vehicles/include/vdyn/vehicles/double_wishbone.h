@@ -21,6 +21,10 @@ namespace vdyn {
 struct RigidBodyParams {
   double mass_kg = 1;
   SimTK::Vec3 inertia_kg_m2{1, 1, 1};  ///< principal moments about the c.m., body axes
+  /// The c.m. in the body frame, m (0: the body frame's origin is the c.m., as
+  /// every App. A body; a hardpoint template sets it where the body frame's
+  /// origin is a joint, e.g. a knuckle whose origin is the wheel centre).
+  SimTK::Vec3 com_m{0, 0, 0};
   void validate(const std::string& where) const;
   static RigidBodyParams fromParams(const ParamReader& r);
 };
@@ -52,11 +56,29 @@ struct DoubleWishboneParams {
   double spring_free_length_m = 0.344;
   SimTK::Vec3 spring_chassis_point_m{1.31, -0.395, -0.10};
   SimTK::Vec3 spring_arm_point_m{0, 0, 0};  ///< on the lower arm
+  /// The damper's own points (chassis frame; lower arm frame); App. A's damper
+  /// shares the spring's points (separate_damper false).
+  bool separate_damper = false;
+  SimTK::Vec3 damper_chassis_point_m{0, 0, 0}, damper_arm_point_m{0, 0, 0};
+  /// "none" (the knuckle turns freely about its kingpin, for a steering
+  /// plugin) or "chassis": a fixed-length tie rod from tierod_chassis_point_m
+  /// (chassis frame) to tierod_knuckle_point_m (knuckle frame) holds its steer.
+  std::string tie_rod = "none";
+  SimTK::Vec3 tierod_chassis_point_m{0, 0, 0}, tierod_knuckle_point_m{0, 0, 0};
 
   void validate(const std::string& where) const;
   /// The data-file keys of one corner: "bodies", "joints", "spring".
   static const FieldTable<DoubleWishboneParams>& fields();
   static DoubleWishboneParams fromParams(const ParamReader& r);
+  /// The same corner from chassis-frame hardpoints at design (Chrono::Vehicle's
+  /// names, the form of a published car's data): the block's "hardpoints_m"
+  /// (lca_front, lca_back, lca_upright, uca_front, uca_back, uca_upright,
+  /// spindle, spring_chassis, spring_arm, optional damper_chassis, damper_arm,
+  /// tierod_chassis, tierod_upright) and "bodies" with each body's "com_m"
+  /// (chassis frame; the wheel's is the spindle). Each body frame is placed at
+  /// its c.m. with chassis axes, the knuckle's at the spindle (the spin joint
+  /// at both origins), so the result is this struct in its usual form.
+  static DoubleWishboneParams fromHardpoints(const ParamReader& r);
   /// The left-side corner from a right-side one: points mirrored eta -> -eta,
   /// axes as axial vectors (so the spin axis stays +eta and forward rolling
   /// stays a positive spin on both sides).
@@ -70,6 +92,7 @@ struct DoubleWishboneCorner {
   SimTK::MobilizedBody::Pin upper_arm;
   SimTK::MobilizedBody::Pin wheel;
   SimTK::Constraint::Ball upper_ball;
+  SimTK::Constraint::Rod tie_rod;  ///< empty handle without a tie rod
   SimTK::Force::TwoPointLinearSpring spring;
   SimTK::Force::TwoPointLinearDamper damper;
 };

@@ -75,6 +75,15 @@ struct VehicleReport {
   double total_load_N = 0, weight_N = 0;  ///< sum of corner loads against m g (quarter car: m g of all bodies)
   double chassis_origin_height_m = 0;     ///< chassis body origin above the road (ride height), m
   double com_height_m = 0;                ///< whole-vehicle c.m. above the road, m
+  /// Wheeled vehicles of two axles: the moment balance over the contact
+  /// points at rest. com_x_m is the whole vehicle's c.m. and axle_contact_x_m
+  /// each axle's contact points (Fz-weighted mean) along ground x, m;
+  /// front_axle_load_from_moments_N = W (x_cm - x_rear) / (x_front - x_rear),
+  /// what front_axle_load_N must equal when only gravity and the tires' normal
+  /// forces act in the vehicle's plane (0 otherwise).
+  double com_x_m = 0;
+  std::vector<std::pair<std::string, double>> axle_contact_x_m;
+  double front_axle_load_from_moments_N = 0;
   /// Per axle (a corner standing for it: "front" = rf, "rear" = rr; the quarter car: "corner").
   std::vector<std::pair<std::string, std::vector<KinematicsPoint>>> kinematics;
   std::vector<std::string> replaced_plugins, added_plugins;  ///< as in HandlingScene

@@ -36,6 +36,16 @@ namespace vdyn {
 /// (14 RF before 15 LF).
 inline int sideIndex(WheelSide side) { return side == WheelSide::Right ? 0 : 1; }
 
+/// What a kinematics sweep of one built corner needs (the vehicle report's
+/// SuspensionCorner): the body whose one coordinate drives the wheel travel,
+/// the bodies the loop closure may move, the knuckle, the wheel and the spring.
+struct KinematicCorner {
+  SimTK::MobilizedBody travel_body;
+  std::vector<SimTK::MobilizedBodyIndex> free;
+  SimTK::MobilizedBody knuckle, wheel;
+  SimTK::Force::TwoPointLinearSpring spring;
+};
+
 /// One axle's suspension: both corners, their parameters and, once built,
 /// their handles. Constant once built (the state holds everything that moves).
 class Suspension {
@@ -55,6 +65,11 @@ class Suspension {
   void build(Scene& scene, SimTK::MobilizedBody& chassis, const std::string (&prefixes)[2],
              const std::function<void(int side)>& afterCorner);
 
+  /// Moves the data's chassis frame: every chassis-frame point of both
+  /// corners p becomes p + offset_m (the vehicle builds in a chassis frame at
+  /// the chassis c.m. when the data's frame is elsewhere). Before build().
+  void shiftChassisFrame(const SimTK::Vec3& offset_m) { DoShiftChassisFrame(offset_m); }
+
   /// Body roles of one corner, in build order ("lower_arm", "knuckle", ...):
   /// every one is registered as prefix + role. "wheel" and "knuckle" (the
   /// steered body carrying the wheel's spin joint) are always present.
@@ -68,6 +83,12 @@ class Suspension {
   /// The corner's suspension coordinate in state s (rad or m, per template):
   /// what a vehicle report plots wheel travel against.
   virtual double getSuspensionCoordinate(const SimTK::State& s, int side) const = 0;
+  /// True if the knuckles turn freely about their kingpins (no tie rod holds
+  /// them): only then may a steering plugin steer the axle.
+  virtual bool isSteerable() const = 0;
+  /// The built corner for a kinematics sweep; false if the template has no
+  /// such description (the vehicle report then names it).
+  virtual bool getKinematicCorner(int /*side*/, KinematicCorner* /*k*/) const { return false; }
   /// Largest separation of a loop's cut joint in s before assembly, m (0 for
   /// a loop closed by construction).
   virtual double calcLoopGap(const SimTK::State& /*s*/, int /*side*/) const { return 0; }
@@ -92,6 +113,7 @@ class Suspension {
  protected:
   explicit Suspension(std::string templateName) : template_(std::move(templateName)) {}
   virtual void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) = 0;
+  virtual void DoShiftChassisFrame(const SimTK::Vec3& offset_m) = 0;
 
  private:
   std::string template_;

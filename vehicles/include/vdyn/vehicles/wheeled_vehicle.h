@@ -62,6 +62,11 @@ struct AxleParams {
 
 struct WheeledVehicleParams {
   RigidBodyParams chassis;               ///< App. A body 1 (800 kg; 250/1000/1100 kg m^2)
+  /// The chassis c.m. in the data's chassis frame, m (data key chassis.com_m,
+  /// default 0): the vehicle builds in the frame at the c.m. (its chassis body
+  /// frame, whose origin every chassis output refers to), every template's
+  /// chassis-frame points moved by -com_m.
+  SimTK::Vec3 chassis_com_m{0, 0, 0};
   std::vector<AxleParams> axles;         ///< front to rear
   RoadParams road;                       ///< flat by default
   double gravity_m_per_s2 = 9.81;        ///< along -z, m/s^2
@@ -163,6 +168,7 @@ class WheeledVehicle {
 
  private:
   [[noreturn]] void throwNotTemplate(int axle, const char* what) const;
+  void requireSteerable(int axle, const std::string& plugin) const;
   WheeledVehicleParams p_;
   std::unique_ptr<Scene> scene_;
   SimTK::MobilizedBody::Free chassis_;

@@ -1,6 +1,9 @@
 // The double-wishbone suspension templates (vdyn/templates/double_wishbone.h).
 #include "vdyn/templates/double_wishbone.h"
 
+#include <algorithm>
+#include <cmath>
+
 namespace vdyn {
 
 namespace {
@@ -13,22 +16,48 @@ struct WishboneAxleData {
   DoubleWishboneParams left;
 };
 
+/// One corner in either form: chassis-frame hardpoints ("hardpoints_m"
+/// given, DoubleWishboneParams::fromHardpoints) or App. A's body-frame joints.
+DoubleWishboneParams readCorner(const ParamReader& r) {
+  if (r.has("hardpoints_m") && !r.raw("hardpoints_m").is_null()) {
+    if (r.has("joints")) throw Error(r.at("joints") + ": give either joints (body frames) or hardpoints_m, not both");
+    return DoubleWishboneParams::fromHardpoints(r);
+  }
+  // The hardpoint form's own keys, at their defaults or absent.
+  if (r.stringOr("tie_rod", "none") != "none" || r.numberOr("camber_rad", 0) != 0 || r.numberOr("toe_in_rad", 0) != 0)
+    throw Error(r.where() + ": tie_rod, camber_rad and toe_in_rad belong to the hardpoints_m form (the body-frame "
+                            "form gives joints.wheel_spin_axis)");
+  DoubleWishboneParams p = DoubleWishboneSuspension::fields().read(r);
+  p.validate(r.where());
+  return p;
+}
+
 WishboneAxleData readWishboneAxle(const ParamReader& r) {
   WishboneAxleData d;
-  d.right = DoubleWishboneSuspension::fields().read(r);
-  d.right.validate(r.where());
+  d.right = readCorner(r);
   if (r.has("left") && !r.child("left").json().empty()) {
     const ParamReader l = r.child("left");
     d.hasLeft = true;
-    d.left = DoubleWishboneSuspension::fields().read(l);
+    d.left = readCorner(l);
     l.requireAllKeysRead();
-    d.left.validate(l.where());
   }
   return d;
 }
 
 TypeInfo wishboneInfo(const std::string& summary) {
   TypeInfo t = typeInfo(summary, DoubleWishboneSuspension::fields());
+  for (FieldInfo& f : t.fields)
+    if (f.key == "joints") f.meaning = "(body-frame form, App. A) " + f.meaning;
+  t.fields.push_back({"hardpoints_m", "m", "null",
+                      "(hardpoint form, a published car's) chassis frame at design: lca_front, lca_back, lca_upright, "
+                      "uca_front, uca_back, uca_upright, spindle, spring_chassis, spring_arm; optional damper_chassis, "
+                      "damper_arm, tierod_chassis, tierod_upright; then bodies lower_arm, upper_arm, knuckle carry "
+                      "com_m (chassis frame) and joints is not given"});
+  t.fields.push_back({"tie_rod", "-", "\"none\"",
+                      "(hardpoint form) none (the knuckle steers freely, for a steering plugin) | chassis (a "
+                      "fixed-length rod tierod_chassis - tierod_upright holds it)"});
+  t.fields.push_back({"camber_rad", "rad", "0", "(hardpoint form) static camber, + top of the wheel outward"});
+  t.fields.push_back({"toe_in_rad", "rad", "0", "(hardpoint form) static toe, + toe-in"});
   t.fields.push_back({"left", "-", "{}",
                       "the left corner's bodies, joints and spring in its own coordinates, where it is not the mirror "
                       "of the right (eta -> -eta); {} or absent: the mirror"});
@@ -64,6 +93,18 @@ const FieldTable<DoubleWishboneParams>& DoubleWishboneSuspension::fields() { ret
 
 void DoubleWishboneSuspension::setLeftCorner(const DoubleWishboneParams& left) { params_[1] = left; }
 
+void DoubleWishboneSuspension::DoShiftChassisFrame(const SimTK::Vec3& d) {
+  for (DoubleWishboneParams& p : params_) {
+    for (JointParams* j : {&p.lower_pivot, &p.upper_pivot}) {
+      j->parent_point_m += d;
+      j->parent_axis_point_m += d;
+    }
+    p.spring_chassis_point_m += d;
+    p.damper_chassis_point_m += d;
+    p.tierod_chassis_point_m += d;
+  }
+}
+
 double DoubleWishboneSuspension::calcCornerMass(int side) const {
   const DoubleWishboneParams& c = params_[side];
   return c.lower_arm.mass_kg + c.knuckle.mass_kg + c.upper_arm.mass_kg + c.wheel.mass_kg;
@@ -82,10 +123,27 @@ double DoubleWishboneSuspension::getSuspensionCoordinate(const SimTK::State& s, 
 }
 
 double DoubleWishboneSuspension::calcLoopGap(const SimTK::State& s, int side) const {
-  const JointParams& j = params_[side].upper_ball;
-  return (corners_[side].upper_arm.findStationLocationInGround(s, j.parent_point_m) -
-          corners_[side].knuckle.findStationLocationInGround(s, j.child_point_m))
-      .norm();
+  const DoubleWishboneParams& p = params_[side];
+  const JointParams& j = p.upper_ball;
+  double gap = (corners_[side].upper_arm.findStationLocationInGround(s, j.parent_point_m) -
+                corners_[side].knuckle.findStationLocationInGround(s, j.child_point_m))
+                   .norm();
+  if (p.tie_rod == "chassis") {
+    const SimTK::MobilizedBody& chassis = corners_[side].lower_arm.getParentMobilizedBody();
+    const double length = (wheelCentreInChassis(p) + p.tierod_knuckle_point_m - p.tierod_chassis_point_m).norm();
+    gap = std::max(gap, std::abs((corners_[side].knuckle.findStationLocationInGround(s, p.tierod_knuckle_point_m) -
+                                  chassis.findStationLocationInGround(s, p.tierod_chassis_point_m))
+                                     .norm() -
+                                 length));
+  }
+  return gap;
+}
+
+bool DoubleWishboneSuspension::getKinematicCorner(int side, KinematicCorner* k) const {
+  const DoubleWishboneCorner& c = corners_[side];
+  *k = {c.lower_arm, {c.knuckle.getMobilizedBodyIndex(), c.upper_arm.getMobilizedBodyIndex()}, c.knuckle, c.wheel,
+        c.spring};
+  return true;
 }
 
 void DoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side,
@@ -96,7 +154,11 @@ void DoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody&
 // --- double_wishbone_reduced -------------------------------------------------
 
 ReducedDoubleWishboneSuspension::ReducedDoubleWishboneSuspension(const DoubleWishboneParams& right)
-    : DoubleWishboneSuspension("double_wishbone_reduced", right) {}
+    : DoubleWishboneSuspension("double_wishbone_reduced", right) {
+  if (right.tie_rod != "none")
+    throw Error("double_wishbone_reduced: tie_rod \"" + right.tie_rod +
+                "\" is not in its reduced loop (delta is a mobility); use double_wishbone");
+}
 
 void ReducedDoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side,
                                                     const std::string& prefix) {

@@ -125,6 +125,13 @@ SimTK::UnitVec3 MacPhersonStrutParams::calcSpinAxis(bool right) const {
 MacPhersonStrutSuspension::MacPhersonStrutSuspension(const MacPhersonStrutParams& right)
     : Suspension("macpherson_strut"), params_{right, right.mirrored()} {}
 
+void MacPhersonStrutSuspension::DoShiftChassisFrame(const SimTK::Vec3& d) {
+  for (MacPhersonStrutParams& p : params_)
+    for (Vec3* x : {&p.lower_arm.com_m, &p.upright.com_m, &p.lca_front_m, &p.lca_back_m, &p.lca_upright_m,
+                    &p.strut_chassis_m, &p.strut_upright_m, &p.spindle_m, &p.tierod_chassis_m, &p.tierod_upright_m})
+      *x += d;
+}
+
 double MacPhersonStrutSuspension::calcCornerMass(int side) const {
   const MacPhersonStrutParams& p = params_[side];
   return p.lower_arm.body.mass_kg + p.upright.body.mass_kg + p.wheel.mass_kg;

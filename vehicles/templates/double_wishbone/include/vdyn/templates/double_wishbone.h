@@ -33,11 +33,14 @@ class DoubleWishboneSuspension : public Suspension {
   SimTK::UnitVec3 getSpinAxis(int side) const override;
   double getSuspensionCoordinate(const SimTK::State& s, int side) const override;
   double calcLoopGap(const SimTK::State& s, int side) const override;
+  bool getKinematicCorner(int side, KinematicCorner* k) const override;
+  bool isSteerable() const override { return params_[0].tie_rod == "none" && params_[1].tie_rod == "none"; }
 
  protected:
   DoubleWishboneSuspension(std::string name, const DoubleWishboneParams& right)
       : Suspension(std::move(name)), params_{right, right.mirrored()} {}
   void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) override;
+  void DoShiftChassisFrame(const SimTK::Vec3& offset_m) override;
   DoubleWishboneParams params_[2];
 
  private:
@@ -61,6 +64,7 @@ class ReducedDoubleWishboneSuspension : public DoubleWishboneSuspension {
                        double delta_rad) const override;
   std::vector<ArmPlanesImpl::Row> getArmRows(int side) const override;
   bool getDenseArm(int side, ReducedDenseRows::Arm* arm) const override;
+  bool getKinematicCorner(int, KinematicCorner*) const override { return false; }
 
  protected:
   void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) override;

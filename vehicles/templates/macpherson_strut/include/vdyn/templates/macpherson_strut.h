@@ -84,9 +84,16 @@ class MacPhersonStrutSuspension : public Suspension {
   SimTK::UnitVec3 getSpinAxis(int side) const override { return params_[side].calcSpinAxis(side == 0); }
   double getSuspensionCoordinate(const SimTK::State& s, int side) const override;
   double calcLoopGap(const SimTK::State& s, int side) const override;
+  bool isSteerable() const override { return params_[0].tie_rod == "none" && params_[1].tie_rod == "none"; }
+  bool getKinematicCorner(int side, KinematicCorner* k) const override {
+    const MacPhersonStrutCorner& c = corners_[side];
+    *k = {c.lower_arm, {c.upright.getMobilizedBodyIndex()}, c.upright, c.wheel, c.spring};
+    return true;
+  }
 
  protected:
   void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) override;
+  void DoShiftChassisFrame(const SimTK::Vec3& offset_m) override;
 
  private:
   MacPhersonStrutParams params_[2];
