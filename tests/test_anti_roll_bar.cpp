@@ -200,6 +200,35 @@ TEST(AntiRollBar, WorkOverAnUndampedTransientIsMinusDeltaV) {
   EXPECT_NEAR(work, -(v1 - v0), 1e-5 * std::max(v0, v1));
 }
 
+TEST(AntiRollBar, DampingTorqueIsCTimesTheTwistRateAndDissipates) {
+  WheeledVehicleParams p = arbParams();
+  p.updAxle("front").anti_roll_bar["damping_N_m_s_per_rad"] = 40.0;
+  const WheeledVehicle car(p);
+  const SimTK::MultibodySystem& sys = car.getScene().getSystem();
+  SimTK::State s = car.makeInitialState();
+  moveCorner(car, s, RF, 0.04);
+  SimTK::RungeKuttaMersonIntegrator integ(sys);
+  integ.setAccuracy(1e-8);
+  SimTK::TimeStepper ts(sys, integ);
+  ts.initialize(s);
+  ts.stepTo(0.01);  // moving now
+  const SimTK::State& st = ts.getState();
+  sys.realize(st, SimTK::Stage::Velocity);
+  // phi_dot by central differences of the twist along qdot.
+  const double eps = 1e-7;
+  SimTK::State sp = st, sm = st;
+  sp.updQ() += eps * st.getQDot();
+  sm.updQ() -= eps * st.getQDot();
+  const Scene& sc = car.getScene();
+  const double phi = sc.evalOutput("front_arb.twist_rad", st);
+  const double phidot = (sc.evalOutput("front_arb.twist_rad", sp) - sc.evalOutput("front_arb.twist_rad", sm)) / (2 * eps);
+  const double T = 1500.0 * phi + 40.0 * phidot;
+  EXPECT_GT(std::abs(40.0 * phidot), 0.1 * std::abs(1500.0 * phi));  // the damping term matters here
+  EXPECT_NEAR(sc.evalOutput("front_arb.torque_N_m", st), T, 1e-6 * std::abs(T));
+  const double power = ~barForce(car, st) * st.getU();
+  EXPECT_NEAR(power, -T * phidot, 1e-6 * std::abs(T * phidot));  // dV/dt plus the dissipation c phi_dot^2
+}
+
 namespace {
 
 /// App. A (with or without its front bar), the knuckles held at zero steer,
