@@ -32,6 +32,7 @@
 #include "vdyn/steering_ratio/linear_ratio.h"
 #include "vdyn/tire/tire_model.h"
 #include "vdyn/vehicles/standard_registry.h"
+#include "vdyn/vehicles/anti_roll_bar.h"
 #include "vdyn/vehicles/suspension.h"
 
 using namespace vdyn;
@@ -201,8 +202,8 @@ TEST(RegistryKeys, EveryChoiceAcceptsExactlyItsListedKeys) {
   const PluginRegistry& reg = standardRegistry();
   const KrTable table = KrTable::fromFile(resolveDataPath("kr_table.json"));
   const std::vector<std::string> families = reg.choiceFamilies();
-  EXPECT_EQ(families, (std::vector<std::string>{"rear_steer_strategy", "sensitivity_method", "steering_command",
-                                                "suspension_template"}))
+  EXPECT_EQ(families, (std::vector<std::string>{"anti_roll_bar_template", "rear_steer_strategy",
+                                                "sensitivity_method", "steering_command", "suspension_template"}))
       << "a new choice family: add its Base and Context to this test";
   for (const auto& family : families)
     for (const auto& type : reg.knownChoices(family)) {
@@ -219,6 +220,8 @@ TEST(RegistryKeys, EveryChoiceAcceptsExactlyItsListedKeys) {
           reg.createChoice<SensitivityMethod, SensitivitySettings>(family, type, r, SensitivitySettings{}, "t.json");
         else if (family == "suspension_template")
           reg.createChoice<Suspension>(family, type, r, NoContext{}, "t.json");
+        else if (family == "anti_roll_bar_template")
+          reg.createChoice<AntiRollBar>(family, type, r, NoContext{}, "t.json");
       });
     }
 }
@@ -259,8 +262,13 @@ TEST(RegistryKeys, WheeledListsItsTemplatesAndForwardDynamics) {
   for (const char* t : {"double_wishbone", "double_wishbone_reduced"}) {
     std::set<std::string> keys;
     for (const auto& f : standardRegistry().choiceInfo("suspension_template", t).fields) keys.insert(f.key);
-    EXPECT_EQ(keys, (std::set<std::string>{"bodies", "joints", "spring", "left"})) << t;
+    EXPECT_EQ(keys, (std::set<std::string>{"bodies", "joints", "spring", "left", "hardpoints_m", "tie_rod",
+                                           "camber_rad", "toe_in_rad"}))
+        << t;
   }
+  std::set<std::string> strut;
+  for (const auto& f : standardRegistry().choiceInfo("suspension_template", "macpherson_strut").fields) strut.insert(f.key);
+  EXPECT_EQ(strut, (std::set<std::string>{"bodies", "hardpoints_m", "tie_rod", "camber_rad", "toe_in_rad", "spring"}));
   EXPECT_EQ(defaults["data: forward_dynamics"], "\"simbody\"");
   EXPECT_EQ(defaults["data: gravity_m_per_s2"], "9.81");
 }

@@ -147,6 +147,7 @@ TypeInfo info(const std::string& summary, const FieldTable<P>& data) {
 
 void registerVehicles(PluginRegistry& registry) {
   registerSuspensionTemplates(registry);
+  registerAntiRollBarTemplates(registry);
   for (const char* type : {"wheeled", "fourws"}) {
     TypeInfo t = info(std::string(type) == "fourws"
                           ? "the wheeled vehicle under the App. A car's name (kept so scenes naming it keep working)"

@@ -87,6 +87,12 @@ std::vector<AxleParams> readAxles(const ParamReader& r, const PluginRegistry& re
     } else {
       ax.prefixes = {std::string("r") + name[0], std::string("l") + name[0]};
     }
+    if (a.has("anti_roll_bar")) {
+      const ParamReader bar = a.child("anti_roll_bar");
+      ax.anti_roll_bar = bar.json();
+      ax.anti_roll_bar_where = bar.where();
+      makeAntiRollBar(registry, bar);  // validates it at load
+    }
     a.requireAllKeysRead();
     axles.push_back(std::move(ax));
   }
@@ -117,7 +123,8 @@ const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
           .custom("axles", "-", "required",
                   "{NAME: {\"suspension\": {\"template\": double_wishbone|double_wishbone_reduced|..., the "
                   "template's keys (right corner; \"left\" if not its mirror)}, \"tire\": {merged over the "
-                  "vehicle's tire}, \"prefixes\": [right, left] (default r<N>, l<N>)}}, ordered front to rear",
+                  "vehicle's tire}, \"prefixes\": [right, left] (default r<N>, l<N>), \"anti_roll_bar\": "
+                  "{\"template\": torsion_bar|..., the template's keys} (optional)}}, ordered front to rear",
                   [](const ParamReader&, P&) {})  // read by fromParams, with the registry
           .custom("road", "-", "{\"type\": \"flat\"}", "road: {\"type\": flat|sine, ...}",
                   [](const ParamReader& r, P& p) {
@@ -155,7 +162,7 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
   sc.setService<const Road>("road", makeRoad(p_.road));
   for (std::size_t ai = 0; ai < p_.axles.size(); ++ai) {
     const AxleParams& ap = p_.axles[ai];
-    axles_.push_back({ap.suspension.create(registry)});
+    axles_.push_back({ap.suspension.create(registry), nullptr});
     Suspension& susp = *axles_.back().suspension;
     if (p_.chassis_com_m != SimTK::Vec3(0)) susp.shiftChassisFrame(-p_.chassis_com_m);
     const std::string prefixes[2] = {ap.prefixes[0] + ".", ap.prefixes[1] + "."};
@@ -173,6 +180,11 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
       sc.addOutput({prefixes[side] + "spin_rad_s", "rad/s", SimTK::Stage::Velocity,
                     [wheel](const SimTK::State& s) { return wheel.getOneU(s, 0); }});
     });
+    if (!ap.anti_roll_bar.empty()) {
+      const ParamReader bar = ParamReader::fromJson(ap.anti_roll_bar, ap.anti_roll_bar_where);
+      axles_.back().anti_roll_bar = makeAntiRollBar(registry, bar);
+      axles_.back().anti_roll_bar->build(sc, chassis_, susp, ap.name, bar.where());
+    }
   }
   // Rows the templates gather into one constraint object for the whole vehicle.
   std::vector<ArmPlanesImpl::Row> rows;

@@ -74,6 +74,13 @@ class Suspension {
   /// every one is registered as prefix + role. "wheel" and "knuckle" (the
   /// steered body carrying the wheel's spin joint) are always present.
   virtual std::vector<std::string> bodyRoles() const = 0;
+  /// True if a corner of this template has a body of role `role`.
+  bool hasBodyRole(const std::string& role) const;
+  /// The built body of role `role` on `side` (0 right, 1 left), after build():
+  /// the typed attachment other subsystems (an anti-roll bar) reach the
+  /// corners by. Throws Error naming the template and the role, listing its
+  /// roles, for a role it does not have.
+  const SimTK::MobilizedBody& getBody(int side, const std::string& role) const;
   /// Bodies whose mass is carried by the tires beside the chassis, kg (one corner).
   virtual double calcCornerMass(int side) const = 0;
   /// The wheel centre in the chassis frame in the tabulated configuration, m.
@@ -117,6 +124,7 @@ class Suspension {
 
  private:
   std::string template_;
+  std::map<std::string, SimTK::MobilizedBody> bodies_[2];  ///< by role, filled by build()
 };
 
 /// The registry's choice family of suspension templates: a data file's

@@ -13,7 +13,8 @@
 //   {"chassis": {mass_kg, inertia_kg_m2},
 //    "tire": {"plugin": KIND, "params": {...}},     // every axle's, unless its own
 //    "axles": {"front": {"suspension": {"template": "double_wishbone", ...},
-//                        "tire": {...}},             // optional, merged over "tire"
+//                        "tire": {...},              // optional, merged over "tire"
+//                        "anti_roll_bar": {"template": "torsion_bar", ...}},  // optional
 //              "rear": {...}},
 //    "road": {...}, "gravity_m_per_s2": 9.81, "forward_dynamics": "simbody"}
 // Axles are ordered front to rear by their wheel centres' xi; a corner's
@@ -35,6 +36,7 @@
 #include "vdyn/vehicles/reduced_wishbone.h"
 #include "vdyn/templates/double_wishbone.h"
 #include "vdyn/vehicles/suspension.h"
+#include "vdyn/vehicles/anti_roll_bar.h"
 
 namespace vdyn {
 
@@ -57,6 +59,10 @@ struct AxleParams {
   std::array<std::string, 2> prefixes; ///< corner names, right and left ("rf", "lf")
   SuspensionChoice suspension;
   TireChoice tire;                     ///< this axle's tire kind and params
+  /// Data key "anti_roll_bar": {"template": "torsion_bar", ...} (anti_roll_bar.h);
+  /// an empty block: none.
+  Json anti_roll_bar = Json::object();
+  std::string anti_roll_bar_where = "anti_roll_bar";  ///< its data-file location, for messages
   double wheel_centre_x_m = 0;         ///< xi of the right wheel centre (tabulated), for the order
 };
 
@@ -110,6 +116,8 @@ class WheeledVehicle {
   const std::string& cornerName(int c) const { return p_.axles.at(c / 2).prefixes[c % 2]; }
   /// The built suspension of an axle.
   const Suspension& suspension(int axle) const { return *axles_.at(axle).suspension; }
+  /// The built anti-roll bar of an axle, or null if it has none.
+  const AntiRollBar* antiRollBar(int axle) const { return axles_.at(axle).anti_roll_bar.get(); }
   /// The suspension of an axle as template class S; throws Error naming the
   /// axle and its template if it is not one.
   template <class S>
@@ -174,6 +182,7 @@ class WheeledVehicle {
   SimTK::MobilizedBody::Free chassis_;
   struct Axle {
     std::unique_ptr<Suspension> suspension;
+    std::unique_ptr<AntiRollBar> anti_roll_bar;  ///< null: none
   };
   std::vector<Axle> axles_;
   ReducedDenseRows* dense_ = nullptr;  ///< owned by its Force::Custom
