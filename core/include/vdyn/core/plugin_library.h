@@ -23,9 +23,11 @@
 /// PluginRegistry, PluginSpec, ParamReader, Scene, Vehicle, Analysis, TypeInfo)
 /// changes its layout or virtual functions. 2: PluginSpec::registry, choices
 /// in PluginRegistry, Vehicle::getConcrete/derivedData. 3: FieldInfo::type; every
-/// registration takes its TypeInfo (typeInfo(summary, table)). A library must return the value it
+/// registration takes its TypeInfo (typeInfo(summary, table)). 4: the vehicles'
+/// subsystem templates (Suspension, AntiRollBar) as choice families a library
+/// may add to; WheeledVehicle for FourWsVehicle. A library must return the value it
 /// was compiled with from vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 3
+#define VDYN_PLUGIN_ABI_VERSION 4
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))
