@@ -91,14 +91,16 @@ TEST(BoundedInput, OversizedFileIsANamedError) {
 
 TEST(BoundedInput, VdynCheckOnADeeplyNestedSceneExitsOneNotACrash) {
   const std::string d = freshDir("deep_scene");
-  writeText(d + "/deep.json", nested(200000));
+  // A scene object holding 200,000 nested arrays: before the limit, exit 139
+  // (a segmentation fault) in both check and run.
+  writeText(d + "/deep.json", "{\"name\": " + nested(200000) + "}");
   const Ran r = runVdyn("check '" + d + "/deep.json'", d);
   EXPECT_EQ(r.rc, 1);
   EXPECT_EQ(r.err, "vdyn check: error: data file '" + d +
-                       "/deep.json' nests 200000 arrays/objects deep (line 1, column 101 passes the limit of 100)\n");
+                       "/deep.json' nests 200001 arrays/objects deep (line 1, column 109 passes the limit of 100)\n");
   const Ran s = runVdyn("run '" + d + "/deep.json' --no-plots --out '" + d + "/out'", d);
   EXPECT_EQ(s.rc, 1);
-  EXPECT_NE(s.err.find("nests 200000 arrays/objects deep"), std::string::npos) << s.err;
+  EXPECT_NE(s.err.find("nests 200001 arrays/objects deep"), std::string::npos) << s.err;
 }
 
 TEST(BoundedInput, TenToTheTenVariationsAreRefusedBeforeAllocation) {

@@ -303,8 +303,8 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
   if (haveVehicle && pluginsOk && !built.empty()) {
     std::unique_ptr<SimTK::State> initial;
     if (attempt(root.at("vehicle"), nullptr, [&] { initial = std::make_unique<SimTK::State>(b.makeInitialState()); }))
-      for (const auto& [where, plugin] : built)
-        attempt(where, nullptr, [&] { plugin->checkInitialState(b.scene(), *initial); });
+      for (const auto& entry : built)
+        attempt(entry.first, nullptr, [&] { entry.second->checkInitialState(b.scene(), *initial); });
   }
 
   // Outputs to record.

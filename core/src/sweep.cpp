@@ -554,6 +554,7 @@ std::string sweepJournalLine(const SweepDescription& d, const SweepRow& row) {
 
 SweepRow parseSweepJournalLine(const SweepDescription& d, const std::string& line, const std::string& where) {
   Json j;
+  requireJsonDepth(line, where);  // bounded input: a corrupt line nesting 1e5 levels is named, not a crash
   try {
     j = Json::parse(line);
   } catch (const std::exception& e) {

@@ -54,11 +54,6 @@ std::string fmt(double v) {
   return buf;
 }
 
-OutputFile openCsv(const std::string& path, const std::string& header) {
-  OutputFile out(path);
-  out << header << '\n';
-  return out;
-}
 
 /// Column name of one (model, load) series in the wide plot helpers.
 std::string seriesName(const std::string& model, double Fz) { return model + "_Fz" + fmt(Fz) + "_N"; }
@@ -106,7 +101,8 @@ int main(int argc, char** argv) {
     std::map<std::string, std::map<double, Peak>> peakFy, peakFx;
     std::vector<std::vector<double>> latWide(kAlphaPoints);
     {
-      OutputFile csv = openCsv(out + "/lateral.csv", "model,Fz_N,alpha_rad,Fy_N");
+      OutputFile csv(out + "/lateral.csv");
+      csv << "model,Fz_N,alpha_rad,Fy_N" << '\n';
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N)
           for (int i = 0; i < kAlphaPoints; ++i) {
@@ -121,7 +117,8 @@ int main(int argc, char** argv) {
     // --- Pure longitudinal slip ---------------------------------------------------------
     std::vector<std::vector<double>> lonWide(kKappaPoints);
     {
-      OutputFile csv = openCsv(out + "/longitudinal.csv", "model,Fz_N,slip_ratio,Fx_N");
+      OutputFile csv(out + "/longitudinal.csv");
+      csv << "model,Fz_N,slip_ratio,Fx_N" << '\n';
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N)
           for (int i = 0; i < kKappaPoints; ++i) {
@@ -137,7 +134,8 @@ int main(int argc, char** argv) {
     std::vector<std::vector<double>> comboWide(kKappaPoints);
     Json combinedSummary = Json::object();
     {
-      OutputFile csv = openCsv(out + "/combined.csv", "model,Fz_N,slip_ratio,alpha_rad,Fx_N,Fy_N");
+      OutputFile csv(out + "/combined.csv");
+      csv << "model,Fz_N,slip_ratio,alpha_rad,Fx_N,Fy_N" << '\n';
       for (const std::string& name : kModels)
         for (double alpha : kCombinedAlphas_rad) {
           double maxResultant = 0;
@@ -159,7 +157,8 @@ int main(int argc, char** argv) {
       std::string head = "alpha_rad";
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N) head += "," + seriesName(name, Fz);
-      OutputFile csv = openCsv(out + "/lateral_plot.csv", head);
+      OutputFile csv(out + "/lateral_plot.csv");
+      csv << head << '\n';
       for (int i = 0; i < kAlphaPoints; ++i) {
         csv << fmt(alphaAt(i));
         for (double v : latWide[i]) csv << ',' << fmt(v);
@@ -168,7 +167,8 @@ int main(int argc, char** argv) {
       head = "slip_ratio";
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N) head += "," + seriesName(name, Fz);
-      OutputFile csv2 = openCsv(out + "/longitudinal_plot.csv", head);
+      OutputFile csv2(out + "/longitudinal_plot.csv");
+      csv2 << head << '\n';
       for (int i = 0; i < kKappaPoints; ++i) {
         csv2 << fmt(kappaAt(i));
         for (double v : lonWide[i]) csv2 << ',' << fmt(v);
@@ -179,7 +179,8 @@ int main(int argc, char** argv) {
         for (double alpha : kCombinedAlphas_rad)
           head += "," + comboName(name, alpha, "Fx_N") + "," + comboName(name, alpha, "Fy_N");
       head += ",circle_mu_max_Fx_N,circle_mu_max_Fy_N,circle_mu_min_Fx_N,circle_mu_min_Fy_N";
-      OutputFile csv3 = openCsv(out + "/combined_plot.csv", head);
+      OutputFile csv3(out + "/combined_plot.csv");
+      csv3 << head << '\n';
       for (int i = 0; i < kKappaPoints; ++i) {
         csv3 << fmt(kappaAt(i));
         for (double v : comboWide[i]) csv3 << ',' << fmt(v);

@@ -20,7 +20,6 @@ void writeFileAtomic(const std::string& path, const std::string& text);
 class OutputFile : public std::ostringstream {
  public:
   explicit OutputFile(std::string path) : path_(std::move(path)) {}
-  OutputFile(OutputFile&&) = default;
   void commit() const { writeFileAtomic(path_, str()); }
   const std::string& path() const { return path_; }
 
