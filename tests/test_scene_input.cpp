@@ -203,11 +203,11 @@ TEST(Consistency, SpeedHoldAgainstInitialSpeedIsNamedByCheckAndRun) {
   const std::string d = freshDir("speed_hold");
   const Ran c = runVdyn("check scenes/ch3_transient.json --set plugins.speed_hold.speed_m_s=20", d);
   EXPECT_EQ(c.rc, 1);
-  const std::string why = "plugins[2]: speed_m_s = 20 m/s differs from the vehicle's initial speed 10 m/s "
+  const std::string why = "speed_hold 'speed_hold': speed_m_s = 20 m/s differs from the vehicle's initial speed 10 m/s "
                           "(vehicle.initial_speed_m_s): a speed hold cannot change the speed at t = 0; set both to "
                           "the same value\n";
   EXPECT_EQ(c.err.substr(0, 19), "vdyn check: error: ");
-  EXPECT_NE(c.err.find(why), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("ch3_transient.json: plugins: " + why), std::string::npos) << c.err;
   EXPECT_EQ(std::count(c.err.begin(), c.err.end(), '\n'), 1) << c.err;
   const Ran r = runVdyn("run scenes/ch3_transient.json --no-plots --set plugins.speed_hold.speed_m_s=20 --out '" + d +
                             "/out'",

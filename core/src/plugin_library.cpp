@@ -28,11 +28,12 @@ void loadPluginLibrary(const std::string& path, PluginRegistry& registry) {
   std::lock_guard<std::mutex> lock(libMutex());
   std::error_code ec;
   const std::string canonical = std::filesystem::canonical(path, ec).string();
+  if (ec && !path.empty() && path[0] == '/') throw Error("plugin library '" + path + "': not found");
   if (ec) {
     std::error_code cwdError;
     const std::string cwd = std::filesystem::current_path(cwdError).string();
     throw Error("plugin library '" + path + "': not found (looked for " +
-                (!path.empty() && path[0] == '/' ? path : (cwdError ? "" : cwd + "/") + path) +
+                (cwdError ? "" : cwd + "/") + path +
                 "; a scene's plugin_libraries resolve relative to the scene, then along the data path)");
   }
   if (loadedInto().count({canonical, &registry})) return;

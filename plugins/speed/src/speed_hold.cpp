@@ -96,7 +96,7 @@ void SpeedHoldPlugin::DoCheckInitialState(const Scene& scene, const SimTK::State
   const double U = std::hypot(SimTK::dot(R.x(), v), SimTK::dot(R.y(), v));
   const double held = getSpeed(initial);
   if (std::abs(U - held) > 1e-6 * std::max(1.0, held))
-    throw Error("speed_m_s = " + formatValue(held) + " m/s differs from the vehicle's initial speed " + formatValue(U) +
+    throw Error("speed_hold '" + name() + "': speed_m_s = " + formatValue(held) + " m/s differs from the vehicle's initial speed " + formatValue(U) +
                 " m/s (vehicle.initial_speed_m_s): a speed hold cannot change the speed at t = 0; set both to the "
                 "same value");
 }
