@@ -241,12 +241,12 @@ int main(int argc, char** argv) {
     if (!vm.count("skip-sweep")) {
       std::printf("\n%-12s %-12s %9s %7s %7s %10s %8s %11s %11s\n", "model", "integrator", "accuracy", "steps", "evals",
                   "CPU (s)", "RTF", "err yaw", "err roll");
-      std::ofstream csv(out + "/work_precision.csv");
+      OutputFile csv(out + "/work_precision.csv");
       csv << "model,integrator,accuracy,steps,evaluations,cpu_time_s,real_time_factor,error_yaw_rate,error_roll\n";
       for (const auto& model : models)
         for (const auto& m : bench::splitList(vm["integrators"].as<std::string>())) {
           const std::string f = out + "/wp_" + model + "_" + m + ".csv";
-          std::ofstream o(f);
+          OutputFile o(f);
           o << "error_yaw_rate,real_time_factor\n";
           for (double acc : bench::splitNumbers(vm["accuracies"].as<std::string>())) {
             Run r;
@@ -268,8 +268,10 @@ int main(int argc, char** argv) {
                             {"evaluations", r.sum.realizations}, {"cpu_time_s", r.cpu_s}, {"real_time_factor", rtf},
                             {"error_yaw_rate", ey}, {"error_roll", er}});
           }
+          o.commit();
           series.push_back({f, "error_yaw_rate", "real_time_factor", model + " " + m});
         }
+      csv.commit();
     }
     study::writeJson(out + "/summary.json",
                      {{"t_end_s", tEnd}, {"cost_per_evaluation", cost}, {"headline", headline}, {"points", rows}});

@@ -69,7 +69,7 @@ int main(int argc, char** argv) {
 
     if (!vm.count("skip-sweep")) {
       const SensitivityResult ref = makeSensitivityMethod("reference", refSet)->compute(p);
-      std::ofstream csv(out + "/ch4_sensitivity_cost.csv");
+      OutputFile csv(out + "/ch4_sensitivity_cost.csv");
       csv << "method,accuracy,max_rel_error,wall_time_s\n";
       struct Row { std::string m; double acc, err, t; };
       std::vector<Row> rows;
@@ -98,7 +98,7 @@ int main(int argc, char** argv) {
           }
         }
       }
-      csv.close();
+      csv.commit();
       std::printf("\ntime to reach a max relative error (s; '-' not reached in the sweep)\n  %-10s", "method");
       const std::vector<double> targets = {1e-2, 1e-3, 1e-4, 1e-5};
       for (double tg : targets) std::printf(" %10.0e", tg);
@@ -133,7 +133,7 @@ int main(int argc, char** argv) {
     for (const auto& d : model->getParameters()) all.push_back(d.name);
     std::printf("\ncost against the number of parameters (accuracy %g; mixed tolerance %g)\n", acc, set.tolerance);
     std::printf("  %6s %12s %12s %12s %14s\n", "params", "fd_forward", "fd_central", "mixed", "mixed nominal");
-    std::ofstream sc(out + "/ch4_sensitivity_scaling.csv");
+    OutputFile sc(out + "/ch4_sensitivity_scaling.csv");
     sc << "params,fd_forward_s,fd_central_s,mixed_s,mixed_nominal_s\n";
     std::vector<std::pair<int, SensitivityResult>> mixedRuns;
     for (int np : {1, 2, 3, 4, 5, 6, 20}) {
@@ -147,6 +147,7 @@ int main(int argc, char** argv) {
       std::printf("  %6d %12.3f %12.3f %12.3f %14.3f\n", np, tf, tc, mr.wall_time_s, mr.nominal_wall_time_s);
       std::fflush(stdout);
     }
+    sc.commit();
     const auto& m6 = mixedRuns[5].second;
     const auto& m20 = mixedRuns[6].second;
     const double marginal = (m20.wall_time_s - m6.wall_time_s) / 14.0;

@@ -87,7 +87,7 @@ int main(int argc, char** argv) {
     std::printf("reference: rk_merson at %g: psi = %.12g (rk_feldberg at %g differs by %.2e in psi, %.2e in z'')\n",
                 refAcc, ref.psi, refAcc, std::abs(ref2.psi - ref.psi) / ref.psi, refSpread / azScale);
 
-    std::ofstream csv(out + "/work_precision.csv");
+    OutputFile csv(out + "/work_precision.csv");
     csv << "integrator,accuracy,steps,wall_time_s,error_az,error_psi,psi\n";
     std::printf("\n%-22s %9s %8s %12s %11s %11s\n", "integrator", "accuracy", "steps", "wall (ms)", "err z''", "err psi");
     Json table = Json::array();
@@ -113,7 +113,7 @@ int main(int argc, char** argv) {
                          {"error_az", eaz}, {"error_psi", epsi}});
       }
     }
-    csv.close();
+    csv.commit();
 
     // Framework overhead: the same model, integrator and sampling, alternating.
     bench::PlainQuarterCar plain(params);
@@ -152,10 +152,11 @@ int main(int argc, char** argv) {
       std::vector<study::Series> series;
       for (const auto& method : bench::splitList(vm["integrators"].as<std::string>())) {
         const std::string f = out + "/wp_" + method + ".csv";
-        std::ofstream o(f);
+        OutputFile o(f);
         o << "wall_time_s,error_az\n";
         for (const auto& row : table)
           if (row["integrator"] == method) o << row["wall_time_s"].get<double>() << ',' << row["error_az"].get<double>() << '\n';
+        o.commit();
         series.push_back({f, "error_az", "wall_time_s", method});
       }
       study::PlotSpec p{out + "/work_precision.png", "Quarter car: run time against error (1 s, sine road)",

@@ -67,7 +67,9 @@ TEST(DataFile, UnknownTirePluginListsKnownOnes) {
   j["tire"]["plugin"] = "pacejka";
   // The ride-height spring is computed while parsing, so parsing builds the car.
   EXPECT_EQ(errorOf([&] { parse(j); }),
-            "quarter car tire plugin: unknown force element plugin 'pacejka'; known: body_force, fiala, gim, linear, magic_formula");
+            "quarter car tire plugin: unknown force element plugin 'pacejka'; known: body_force, fiala, gim, linear, magic_formula"
+            "; no force element library registers it: load the one that does with --plugin LIB.so or the scene's "
+            "\"plugin_libraries\"");
 }
 
 TEST(DataFile, UnknownRoadTypeListsKnownOnes) {
@@ -112,7 +114,8 @@ TEST(Registry, DuplicateAndUnknownNames) {
   EXPECT_EQ(errorOf([&] { registerTirePlugins(r); }), "force element plugin 'gim' is already registered");
   const PluginSpec spec{"x", ParamReader::fromJson(Json::object(), "spec")};
   EXPECT_EQ(errorOf([&] { r.create(PluginKind::Controller, "pid", spec, "scene.json: controller"); }),
-            "scene.json: controller: unknown controller plugin 'pid'; known: (none)");
+            "scene.json: controller: unknown controller plugin 'pid'; known: (none); no controller library registers "
+            "it: load the one that does with --plugin LIB.so or the scene's \"plugin_libraries\"");
 }
 
 TEST(Integrators, UnknownNameAndBadAccuracy) {

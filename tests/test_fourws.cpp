@@ -82,7 +82,9 @@ TEST(FourWs, UnknownTirePluginListsKnownOnes) {
     WheeledVehicle car(p);
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "appendix_a.json: tire.plugin: unknown force element plugin 'magic'; known: body_force, fiala, gim, linear, magic_formula");
+    EXPECT_STREQ(e.what(), "appendix_a.json: tire.plugin: unknown force element plugin 'magic'; known: body_force, fiala, gim, "
+                           "linear, magic_formula; no force element library registers it: load the one that does with "
+                           "--plugin LIB.so or the scene's \"plugin_libraries\"");
   }
 }
 

@@ -146,7 +146,7 @@ TEST(SweepFile, StrictKeysAndNamedErrors) {
             "my.sweep.json: variation: unknown key (did you mean 'variations'?); known: scene, name, set, "
             "variations, collect, output, plots");
   EXPECT_EQ(load(R"({"scene": "s.json", "variations": [{"grid": [{"key": "a", "from": 0, "to": 1, "count": -3}]}]})"),
-            "my.sweep.json: variations[0].grid[0].count: expected an integer in [1, 100000000], got -3");
+            "my.sweep.json: variations[0].grid[0].count: expected an integer in [1, 1000000], got -3");
   EXPECT_EQ(load(R"({"scene": "s.json", "variations": [{"grid": [{"key": "a", "valuse": [1]}]}]})"),
             "my.sweep.json: variations[0].grid[0].valuse: unknown key (did you mean 'values'?); known: key, keys, "
             "values, from, to, count");

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <climits>
+#include <cstdint>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -108,8 +109,34 @@ std::string lineColumn(const std::string& text, std::size_t pos) {
 }
 }  // namespace
 
+void requireJsonDepth(const std::string& text, const std::string& name) {
+  std::size_t depth = 0, deepest = 0, first = std::string::npos;
+  const std::size_t n = text.size();
+  for (std::size_t i = 0; i < n; ++i) {
+    const char c = text[i];
+    if (c == '"') {  // a string: skip to its closing quote
+      for (++i; i < n && text[i] != '"'; ++i)
+        if (text[i] == '\\') ++i;
+    } else if (c == '/' && i + 1 < n && text[i + 1] == '/') {
+      while (i < n && text[i] != '\n') ++i;
+    } else if (c == '/' && i + 1 < n && text[i + 1] == '*') {
+      const std::size_t end = text.find("*/", i + 2);
+      i = end == std::string::npos ? n : end + 1;
+    } else if (c == '[' || c == '{') {
+      if (++depth > deepest) deepest = depth;
+      if (depth > kMaxJsonDepth && first == std::string::npos) first = i + 1;
+    } else if ((c == ']' || c == '}') && depth > 0) {
+      --depth;
+    }
+  }
+  if (first != std::string::npos)
+    throw Error(name + " nests " + std::to_string(deepest) + " arrays/objects deep (" + lineColumn(text, first) +
+                " passes the limit of " + std::to_string(kMaxJsonDepth) + ")");
+}
+
 Json parseJsonText(const std::string& text, const std::string& name) {
   if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw Error(name + " is empty (expected a JSON object)");
+  requireJsonDepth(text, name);
   PathSax sax;
   bool ok = false;
   try {
@@ -133,12 +160,22 @@ Json readJsonFile(const std::string& path) {
   struct stat st;
   if (stat(path.c_str(), &st) == 0 && S_ISDIR(st.st_mode))
     throw Error("data file '" + path + "' is a folder, not a JSON file");
+  if (stat(path.c_str(), &st) == 0 && S_ISREG(st.st_mode) && std::uintmax_t(st.st_size) > kMaxJsonFileBytes)
+    throw Error("data file '" + path + "' is " + std::to_string(st.st_size) + " bytes (limit " +
+                std::to_string(kMaxJsonFileBytes) + " bytes, 64 MiB)");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw Error("cannot open data file '" + path + "'");
-  std::ostringstream text;
-  text << in.rdbuf();
+  // Read at most the limit (a device or a pipe has no size to check first).
+  std::string text;
+  char buf[65536];
+  while (in.read(buf, sizeof buf) || in.gcount() > 0) {
+    text.append(buf, std::size_t(in.gcount()));
+    if (text.size() > kMaxJsonFileBytes)
+      throw Error("data file '" + path + "' is more than " + std::to_string(kMaxJsonFileBytes) +
+                  " bytes (the limit, 64 MiB)");
+  }
   if (in.bad()) throw Error("cannot read data file '" + path + "'");
-  return parseJsonText(text.str(), "data file '" + path + "'");
+  return parseJsonText(text, "data file '" + path + "'");
 }
 
 std::vector<std::string> dataSearchPath() {

@@ -7,6 +7,8 @@
 #include <fstream>
 #include <set>
 
+#include "vdyn/core/file_io.h"
+
 namespace vdyn {
 
 namespace {
@@ -37,13 +39,8 @@ std::size_t columnIndex(const Table& t, const std::string& c) {
 /// Writes <png>.gp (the terminal, the output and `script`) and runs it.
 void renderPng(const std::string& png, const std::string& script) {
   const std::string gp = png + ".gp";
-  {
-    std::ofstream g(gp);
-    if (!g) throw Error("cannot write '" + gp + "'");
-    g << "set terminal pngcairo size 1000,650 font 'sans,10'\nset output " << gnuplotQuote(png) << "\n"
-      << "set datafile separator ','\nset grid\nset key noenhanced\n"
-      << script;
-  }
+  writeFileAtomic(gp, "set terminal pngcairo size 1000,650 font 'sans,10'\nset output " + gnuplotQuote(png) +
+                          "\nset datafile separator ','\nset grid\nset key noenhanced\n" + script);
   runGnuplot(gp, png);
 }
 }  // namespace

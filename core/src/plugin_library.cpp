@@ -28,7 +28,14 @@ void loadPluginLibrary(const std::string& path, PluginRegistry& registry) {
   std::lock_guard<std::mutex> lock(libMutex());
   std::error_code ec;
   const std::string canonical = std::filesystem::canonical(path, ec).string();
-  if (ec) throw Error("plugin library '" + path + "': not found");
+  if (ec && !path.empty() && path[0] == '/') throw Error("plugin library '" + path + "': not found");
+  if (ec) {
+    std::error_code cwdError;
+    const std::string cwd = std::filesystem::current_path(cwdError).string();
+    throw Error("plugin library '" + path + "': not found (looked for " +
+                (cwdError ? "" : cwd + "/") + path +
+                "; a scene's plugin_libraries resolve relative to the scene, then along the data path)");
+  }
   if (loadedInto().count({canonical, &registry})) return;
 
   void* handle = dlopen(canonical.c_str(), RTLD_NOW | RTLD_LOCAL);

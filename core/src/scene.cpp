@@ -173,7 +173,9 @@ void PluginRegistry::unknown(PluginKind kind, const std::string& type, const std
   for (const auto& n : known(kind)) list += (list.empty() ? "" : ", ") + n;
   throw Error(where + ": unknown " + toString(kind) +
               (kind == PluginKind::Vehicle || kind == PluginKind::Analysis ? " '" : " plugin '") + type +
-              "'; known: " + (list.empty() ? "(none)" : list));
+              "'; known: " + (list.empty() ? "(none)" : list) + "; no " + toString(kind) +
+              " library registers it: load the one that does with --plugin LIB.so or the scene's "
+              "\"plugin_libraries\"");
 }
 
 std::unique_ptr<Plugin> PluginRegistry::create(PluginKind kind, const std::string& type,

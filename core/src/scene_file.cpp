@@ -1,12 +1,14 @@
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/plot.h"
 
+#include <algorithm>
 #include <cctype>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
 
+#include "vdyn/core/file_io.h"
 #include "vdyn/core/key_path.h"
 #include "vdyn/core/plugin_library.h"
 
@@ -15,15 +17,14 @@ namespace vdyn {
 // ---------------------------------------------------------------------------
 // Table, Analysis
 void Table::writeCsv(const std::string& path) const {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write '" + path + "'");
+  std::ostringstream out;
   for (std::size_t i = 0; i < columns.size(); ++i) out << (i ? "," : "") << columns[i];
   out << '\n' << std::setprecision(17);
   for (const auto& row : rows) {
     for (std::size_t i = 0; i < row.size(); ++i) out << (i ? "," : "") << row[i];
     out << '\n';
   }
-  if (!out) throw Error("cannot write '" + path + "'");
+  writeFileAtomic(path, out.str());
 }
 
 AnalysisResult Analysis::run(const AnalysisContext& context) const {
@@ -48,6 +49,7 @@ Override Override::parse(const std::string& text, const std::string& option) {
   const std::string bare = (!lower.empty() && (lower[0] == '-' || lower[0] == '+')) ? lower.substr(1) : lower;
   if (bare == "nan" || bare == "inf" || bare == "infinity")
     throw Error(option + " '" + text + "': " + v + " is not a finite number");
+  requireJsonDepth(v, option + " '" + o.key_path + "=...'");
   try {
     o.value = Json::parse(v);
   } catch (const Json::out_of_range&) {
@@ -65,9 +67,42 @@ void applyOverride(Json& scene, const Override& o, const std::string& where) {
 // ---------------------------------------------------------------------------
 // SceneDescription
 namespace {
+/// The base's plugin list with a derived scene's "plugins" merged over it by
+/// name: an entry whose "name" is a base plugin's is merged over that entry
+/// (JSON merge patch), "remove": true removes it, a new name is appended.
+Json mergePluginsByName(Json base, const Json& derived, const std::string& where) {
+  if (!base.is_array()) base = Json::array();
+  if (!derived.is_array()) throw Error(where + ": expected an array of plugin entries, got " + derived.dump());
+  for (std::size_t i = 0; i < derived.size(); ++i) {
+    const Json& e = derived[i];
+    const std::string w = where + "[" + std::to_string(i) + "]";
+    if (!e.is_object() || !e.contains("name") || !e["name"].is_string())
+      throw Error(w + ": a derived scene's plugin entry needs a \"name\" (it merges over the base's plugin of that "
+                  "name, or is added; \"plugins_replace\": true replaces the base's list), got " + e.dump());
+    const std::string name = e["name"].get<std::string>();
+    auto it = std::find_if(base.begin(), base.end(),
+                           [&](const Json& b) { return b.is_object() && b.value("name", std::string()) == name; });
+    const bool remove = e.contains("remove");
+    if (remove) {
+      if (e["remove"] != Json(true)) throw Error(w + ".remove: expected true, got " + e["remove"].dump());
+      if (e.size() != 2) throw Error(w + ": an entry with \"remove\": true has only \"name\" and \"remove\"");
+      if (it == base.end())
+        throw Error(w + ".remove: the base scene has no plugin '" + name + "' to remove");
+      base.erase(it);
+    } else if (it != base.end()) {
+      it->merge_patch(e);
+    } else {
+      base.push_back(e);
+    }
+  }
+  return base;
+}
+
 /// A scene file with "based_on": "<scene>" is that scene with its own keys
 /// merged over it (JSON merge patch), except "analysis", which replaces the
-/// base's whole (a derived scene runs another analysis on the same scene).
+/// base's whole (a derived scene runs another analysis on the same scene), and
+/// "plugins", merged by name (mergePluginsByName) unless "plugins_replace": true
+/// says the list replaces the base's.
 Json readSceneWithBase(const std::string& resolved, int depth) {
   Json j = readJsonFile(resolved);
   if (!j.is_object() || !j.contains("based_on")) return j;
@@ -76,6 +111,19 @@ Json readSceneWithBase(const std::string& resolved, int depth) {
   Json base = readSceneWithBase(resolveDataPath(j["based_on"].get<std::string>(), resolved), depth + 1);
   j.erase("based_on");
   if (j.contains("analysis")) base.erase("analysis");
+  bool replace = false;
+  if (j.contains("plugins_replace")) {
+    if (!j["plugins_replace"].is_boolean())
+      throw Error(resolved + ": plugins_replace: expected true or false, got " + j["plugins_replace"].dump());
+    replace = j["plugins_replace"].get<bool>();
+    if (replace && !j.contains("plugins"))
+      throw Error(resolved + ": plugins_replace: true needs a \"plugins\" list to replace the base's with");
+    j.erase("plugins_replace");
+  }
+  if (j.contains("plugins") && !replace)
+    j["plugins"] = mergePluginsByName(base.contains("plugins") ? base["plugins"] : Json::array(), j["plugins"],
+                                      resolved + ": plugins");
+  if (j.contains("plugins")) base.erase("plugins");  // merge_patch would merge nothing into an array anyway
   base.merge_patch(j);
   return base;
 }
@@ -156,7 +204,9 @@ PluginKind pluginKind(const ParamReader& e, const std::string& type, const Plugi
     std::string list;
     for (PluginKind k : {PluginKind::ForceElement, PluginKind::Constraint, PluginKind::Controller})
       for (const auto& n : reg.known(k)) list += (list.empty() ? "" : ", ") + n;
-    throw Error(e.at("type") + ": unknown plugin '" + type + "'; known: " + (list.empty() ? "(none)" : list));
+    throw Error(e.at("type") + ": unknown plugin '" + type + "'; known: " + (list.empty() ? "(none)" : list) +
+                "; no force_element, constraint or controller library registers it: load the one that does with "
+                "--plugin LIB.so or the scene's \"plugin_libraries\"");
   }
   throw Error(e.at("type") + ": '" + type + "' is registered for more than one kind; say \"kind\"");
 }
@@ -210,11 +260,16 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
   }
 
   // Plugins, in order (a controller names the steering plugin added before it).
+  bool pluginsOk = true;
+  // Plugins not built, with their error's line in `errors`: their outputs are
+  // not reported one by one (one root cause, one line).
+  std::vector<std::string> failedPlugins;
+  std::vector<std::size_t> failedLine;
   if (root.has("plugins")) {
     std::vector<ParamReader> entries;
     attempt(root.at("plugins"), nullptr, [&] { entries = root.array("plugins"); });
     for (const ParamReader& e : entries) {
-      attempt(e.where(), &e, [&] {
+      const bool ok = attempt(e.where(), &e, [&] {
         const std::string type = e.string("type");
         const std::string name = e.string("name");
         const PluginKind kind = pluginKind(e, type, *registry_);
@@ -231,19 +286,41 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
         }
         b.scene().addPlugin(registry_->create(kind, type, PluginSpec{name, e, bindings, registry_}, e.at("type")));
       });
+      pluginsOk &= ok;
+      if (!ok && errors && e.json().is_object() && e.json().contains("name") && e.json()["name"].is_string()) {
+        failedPlugins.push_back(e.json()["name"].get<std::string>());
+        failedLine.push_back(errors->size() - 1);
+      }
     }
   }
+
+  // What can be known before a run: the vehicle's initial state against each
+  // plugin (Plugin::checkInitialState: a speed hold at another speed than the
+  // vehicle's). `vdyn check` makes that state here; a run meets the same check
+  // in the transient analysis, before the solver. (An analysis that replaces
+  // the scene's plugins, e.g. iso4138, runs regardless.)
+  if (errors && haveVehicle && pluginsOk && root.has("plugins"))
+    attempt(root.at("plugins"), nullptr, [&] {
+      const SimTK::State initial = b.makeInitialState();
+      for (const auto& p : b.scene().getPlugins()) p->checkInitialState(b.scene(), initial);
+    });
 
   // Outputs to record.
   if (root.has("outputs")) {
     attempt(root.at("outputs"), nullptr, [&] {
       const Json& v = root.json().at("outputs");
       if (!v.is_array()) throw Error(root.at("outputs") + ": expected an array of output names, got " + v.dump());
+      std::vector<std::size_t> dependent(failedPlugins.size(), 0);
       for (std::size_t i = 0; i < v.size(); ++i) {
         const std::string where = root.at("outputs") + "[" + std::to_string(i) + "]";
         if (!v[i].is_string()) throw Error(where + ": expected an output name, got " + v[i].dump());
         const std::string n = v[i].get<std::string>();
-        if (haveVehicle && !b.scene().hasOutput(n)) {
+        const auto owner = std::find_if(failedPlugins.begin(), failedPlugins.end(), [&](const std::string& p) {
+          return n.size() > p.size() && n.compare(0, p.size(), p) == 0 && n[p.size()] == '.';
+        });
+        if (haveVehicle && !b.scene().hasOutput(n) && owner != failedPlugins.end()) {
+          ++dependent[std::size_t(owner - failedPlugins.begin())];  // one root cause, one line: summarised below
+        } else if (haveVehicle && !b.scene().hasOutput(n)) {
           std::string list;
           for (const auto& k : b.scene().getOutputNames()) list += (list.empty() ? "" : ", ") + k;
           if (errors) errors->push_back(where + ": the scene has no output '" + n + "'; known: " + list);
@@ -251,6 +328,11 @@ BuiltScene SceneDescription::load(std::vector<std::string>* errors) const {
         }
         b.outputs.push_back(n);
       }
+      for (std::size_t k = 0; k < failedPlugins.size(); ++k)
+        if (dependent[k])
+          (*errors)[failedLine[k]] += " (and " + std::to_string(dependent[k]) + " output" +
+                                      (dependent[k] == 1 ? "" : "s") + " of plugin '" + failedPlugins[k] +
+                                      "' named in \"outputs\")";
     });
   }
 
@@ -309,9 +391,7 @@ Json runScene(const SceneDescription& scene, const RunOptions& options) {
       if (!pngs.empty()) summary["plots"] = pngs;
     }
     const std::string path = options.out_dir + "/summary.json";
-    std::ofstream out(path);
-    if (!out) throw Error("cannot write '" + path + "'");
-    out << std::setprecision(17) << summary.dump(2) << '\n';
+    writeFileAtomic(path, summary.dump(2) + "\n");
   }
   return summary;
 }

@@ -1,4 +1,5 @@
 #include "vdyn/core/simulation.h"
+#include "vdyn/core/interrupt.h"
 
 #include <chrono>
 #include <cmath>
@@ -167,6 +168,9 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
                   formatValue(integ->getTime()) + " s: " + e.what());
     }
     using S = SimTK::Integrator;
+    // A safe point: SIGINT/SIGTERM end the run here (vdyn/core/interrupt.h).
+    throwIfInterrupted("at t = " + formatValue(integ->getTime()) + " s of the run to t_end " + formatValue(s.t_end_s) +
+                       " s");
     if (ownInterpolation) sampleStep(integ->getAdvancedState());
     if (status == S::TimeHasAdvanced) {
       const SimTK::State& adv = integ->getAdvancedState();

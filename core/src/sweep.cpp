@@ -1,5 +1,6 @@
 #include "vdyn/core/sweep.h"
 
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/key_path.h"
 
 #include <algorithm>
@@ -84,7 +85,7 @@ double requireNumber(const Json& j, const std::string& where) {
   return requireFinite(j.get<double>(), where);
 }
 
-long long requireCount(const Json& j, const std::string& where, long long max = 100000000) {
+long long requireCount(const Json& j, const std::string& where, long long max = kMaxSweepVariations) {
   if (!j.is_number_integer() || j.get<long long>() < 1 || j.get<long long>() > max)
     throw Error(where + ": expected an integer in [1, " + std::to_string(max) + "], got " + dumpCompact(j));
   return j.get<long long>();
@@ -125,17 +126,6 @@ std::string csvQuote(const std::string& s) {
     q += c;
   }
   return q + "\"";
-}
-
-void writeFileAtomically(const std::string& path, const std::string& text) {
-  const std::string tmp = path + ".tmp";
-  {
-    std::ofstream f(tmp, std::ios::binary);
-    if (!(f << text) || !f.flush()) throw Error("cannot write '" + tmp + "'");
-  }
-  std::error_code ec;
-  std::filesystem::rename(tmp, path, ec);
-  if (ec) throw Error("cannot rename '" + tmp + "' to '" + path + "': " + ec.message());
 }
 
 }  // namespace
@@ -247,7 +237,7 @@ std::uint64_t SweepDescription::fingerprint() const {
 SweepDescription SweepDescription::fromFile(const std::string& path) {
   const Json j = readJsonFile(path);
   const std::filesystem::path p(path);
-  SweepDescription d = fromJson(j, p.filename().string() + ":", p.parent_path().string());
+  SweepDescription d = fromJson(j, p.filename().string() + ":", p.has_parent_path() ? p.parent_path().string() : ".");
   d.file = path;
   if (d.name.empty()) {
     std::string stem = p.filename().string();
@@ -279,7 +269,21 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
       throw Error(at(where, key) + ": expected a non-empty string, got " + dumpCompact(v));
     return v.get<std::string>();
   };
-  d.scene = resolve(str("scene"), true);
+  // The one path rule (README, "Files resolve where a reader expects them"):
+  // relative to the naming file (this sweep file), then along the data path.
+  d.scene = str("scene");
+  if (!d.scene.empty() && d.scene[0] != '/' && !baseDir.empty()) {
+    const std::string f = d.scene;
+    std::string looked = baseDir;
+    d.scene.clear();
+    if (std::filesystem::is_regular_file(baseDir + "/" + f)) d.scene = baseDir + "/" + f;
+    for (const auto& dir : dataSearchPath()) {
+      if (!d.scene.empty()) break;
+      if (std::filesystem::is_regular_file(dir + "/" + f)) d.scene = dir + "/" + f;
+      looked += ", " + dir;
+    }
+    if (d.scene.empty()) throw Error(at(where, "scene") + ": scene file '" + f + "' not found (looked in " + looked + ")");
+  }
   if (j.contains("name")) d.name = str("name");
   if (j.contains("output")) d.output = resolve(str("output"), false);
   if (j.contains("set")) {
@@ -374,6 +378,19 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
         }
         axes.push_back(std::move(g));
       }
+      // The grid's size is checked before it is built (10^10 variations are a
+      // named refusal, not an exhausted memory).
+      long double total = (long double)d.variations.size(), size = 1;
+      std::string shape;
+      for (const GridAxis& g : axes) {
+        size *= (long double)g.values.size();
+        shape += (shape.empty() ? "" : " x ") + std::to_string(g.values.size());
+      }
+      total += size;
+      if (total > (long double)kMaxSweepVariations)
+        throw Error(wk + ": " + shape + " = " + formatValue(double(size)) + " variations" +
+                    (d.variations.empty() ? "" : " (" + formatValue(double(total)) + " in all)") + "; the limit is " +
+                    std::to_string(kMaxSweepVariations) + " variations per sweep");
       sets = makeGridVariations(axes);
     } else if (kind == "list") {
       const Json& items = requireArray(body, wk);
@@ -392,7 +409,11 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
     } else {
       requireObject(body, wk);
       requireKnownKeys(body, {"samples", "seed", "ranges"}, wk);
-      const int n = int(requireCount(requireKey(body, "samples", wk), at(wk, "samples"), 10000000));
+      const int n = int(requireCount(requireKey(body, "samples", wk), at(wk, "samples")));
+      if (d.variations.size() + std::size_t(n) > kMaxSweepVariations)
+        throw Error(at(wk, "samples") + ": " + std::to_string(n) + " samples make " +
+                    std::to_string(d.variations.size() + std::size_t(n)) + " variations in all; the limit is " +
+                    std::to_string(kMaxSweepVariations) + " variations per sweep");
       const Json& seedJ = requireKey(body, "seed", wk);
       if (!seedJ.is_number_integer() || (seedJ.is_number_integer() && !seedJ.is_number_unsigned() &&
                                          seedJ.get<long long>() < 0))
@@ -417,9 +438,11 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
       sets = kind == "latin_hypercube" ? makeLatinHypercubeVariations(ranges, n, seed)
                                        : makeMonteCarloVariations(ranges, n, seed);
     }
+    if (d.variations.size() + sets.size() > kMaxSweepVariations)
+      throw Error(wv + ": " + std::to_string(d.variations.size() + sets.size()) +
+                  " variations; the limit is " + std::to_string(kMaxSweepVariations) + " variations per sweep");
     d.addVariations(sets);
   }
-  if (d.variations.size() > 100000000) throw Error(wv + ": more than 1e8 variations");
 
   if (j.contains("plots")) {
     const std::string wp = at(where, "plots");
@@ -531,6 +554,7 @@ std::string sweepJournalLine(const SweepDescription& d, const SweepRow& row) {
 
 SweepRow parseSweepJournalLine(const SweepDescription& d, const std::string& line, const std::string& where) {
   Json j;
+  requireJsonDepth(line, where);  // bounded input: a corrupt line nesting 1e5 levels is named, not a crash
   try {
     j = Json::parse(line);
   } catch (const std::exception& e) {
@@ -651,17 +675,8 @@ std::string formatSweepJson(const SweepDescription& d, const std::vector<SweepRo
   return j.dump(2, ' ', false, Json::error_handler_t::replace) + "\n";
 }
 
-std::FILE* openSweepJournal(const std::string& dir, bool append) {
-  const std::string path = dir + "/runs.jsonl";
-  std::FILE* f = std::fopen(path.c_str(), append ? "ab+" : "wb");
-  if (!f) throw Error("cannot write '" + path + "'");
-  // A line cut before its line break (a kill between the two) is closed first.
-  if (append && std::fseek(f, -1, SEEK_END) == 0 && std::fgetc(f) != '\n') {
-    std::fseek(f, 0, SEEK_END);
-    std::fputc('\n', f);
-  }
-  std::fseek(f, 0, SEEK_END);
-  return f;
+std::unique_ptr<AppendFile> openSweepJournal(const std::string& dir, bool append) {
+  return std::make_unique<AppendFile>(dir + "/runs.jsonl", append);
 }
 
 double processCpuSeconds() {
@@ -671,8 +686,13 @@ double processCpuSeconds() {
 }
 
 void writeSweepOutputs(const SweepDescription& d, const SweepResult& r, const std::string& dir) {
-  writeFileAtomically(dir + "/results.csv", formatSweepCsv(d, r.rows));
-  writeFileAtomically(dir + "/results.json", formatSweepJson(d, r.rows));
+  writeFileAtomic(dir + "/results.csv", formatSweepCsv(d, r.rows));
+  {
+    Json results = Json::parse(formatSweepJson(d, r.rows));
+    if (r.partial) results["partial"] = true;
+    writeFileAtomic(dir + "/results.json", r.partial ? results.dump(2, ' ', false, Json::error_handler_t::replace) + "\n"
+                                                     : formatSweepJson(d, r.rows));
+  }
   double runWall = 0, runCpu = 0;
   for (const auto& row : r.rows)
     if (!row.resumed) runWall += row.wall_s, runCpu += row.cpu_s;
@@ -683,6 +703,7 @@ void writeSweepOutputs(const SweepDescription& d, const SweepResult& r, const st
                 {"ran", r.ran},
                 {"failed", r.failed},
                 {"resumed", r.resumed},
+                {"partial", r.partial},
                 {"wall_s", r.wall_s},
                 {"cpu_s", r.cpu_s},
                 {"run_wall_s_sum", runWall},
@@ -695,7 +716,8 @@ void writeSweepOutputs(const SweepDescription& d, const SweepResult& r, const st
                    gethostname(h, sizeof h - 1);
                    return std::string(h);
                  }()}};
-  writeFileAtomically(dir + "/sweep_stats.json", stats.dump(2) + "\n");
+  if (r.partial) stats["interrupted_by"] = r.interrupted_by;
+  writeFileAtomic(dir + "/sweep_stats.json", stats.dump(2) + "\n");
 }
 
 std::function<void(const SweepProgress&)> sweepProgressPrinter(const std::string& label) {
@@ -717,11 +739,11 @@ std::function<void(const SweepProgress&)> sweepProgressPrinter(const std::string
 }
 
 std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
-                                         std::FILE*& journal) {
+                                         std::unique_ptr<AppendFile>& journal) {
   const std::size_t n = d.variations.size();
   res.rows.resize(n);
   std::vector<char> have(n, 0);
-  journal = nullptr;
+  journal.reset();
   if (!o.out_dir.empty()) {
     std::error_code ec;
     std::filesystem::create_directories(o.out_dir, ec);
@@ -759,7 +781,7 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
   const std::size_t n = d.variations.size();
   SweepResult res;
   res.runner = "threads";
-  std::FILE* journal = nullptr;
+  std::unique_ptr<AppendFile> journal;
   const std::vector<std::size_t> pending = prepareSweepRun(d, o, res, journal);
 
   std::mutex mu;
@@ -767,12 +789,19 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
   prog.total = n;
   prog.skipped = res.resumed;
   std::string journalError;
+  std::vector<char> finished(n, 1);  // resumed or run now; the pending ones until they are
+  for (std::size_t i : pending) finished[i] = 0;
   auto record = [&](SweepRow&& row) {
     std::lock_guard<std::mutex> lock(mu);
-    if (journal) {
-      const std::string line = sweepJournalLine(d, row) + "\n";
-      if (std::fwrite(line.data(), 1, line.size(), journal) != line.size() || std::fflush(journal) != 0)
-        journalError = "cannot append to '" + o.out_dir + "/runs.jsonl'";
+    // A run cut short by SIGINT/SIGTERM is not a result: not journaled, run again on resume.
+    if (!row.ok && interruptSignal()) return;
+    finished[row.index] = 1;
+    if (journal && journalError.empty()) {
+      try {
+        journal->appendLine(sweepJournalLine(d, row));
+      } catch (const Error& e) {
+        journalError = e.what();
+      }
     }
     ++prog.done;
     if (!row.ok) ++prog.failed;
@@ -783,7 +812,9 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
   };
   std::atomic<std::size_t> next{0};
   auto worker = [&] {
-    for (std::size_t k; (k = next++) < pending.size();) record(runVariation(d, d.variations[pending[k]], run));
+    // A safe point between variations: after SIGINT/SIGTERM no new one starts.
+    for (std::size_t k; !interruptSignal() && (k = next++) < pending.size();)
+      record(runVariation(d, d.variations[pending[k]], run));
   };
   const int threads = int(std::min<std::size_t>(std::size_t(o.threads), std::max<std::size_t>(1, pending.size())));
   if (threads == 1) {
@@ -793,14 +824,30 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
     for (int t = 0; t < threads; ++t) pool.emplace_back(worker);
     for (auto& t : pool) t.join();
   }
-  if (journal) std::fclose(journal);
   if (!journalError.empty()) throw Error(journalError);
+  if (journal) journal->close();
   if (pending.empty() && o.progress) {
     prog.elapsed_s = 0;
     o.progress(prog);
   }
   res.workers = threads;
   res.ran = prog.done;
+  if (const int sig = interruptSignal()) {
+    // Interrupted: the finished rows (journal and results.csv), marked partial.
+    std::vector<SweepRow> rows;
+    for (std::size_t i = 0; i < n; ++i)
+      if (finished[i]) rows.push_back(std::move(res.rows[i]));
+    const std::size_t have = rows.size();
+    res.rows = std::move(rows);
+    res.partial = true;
+    res.interrupted_by = signalName(sig);
+    finishSweepRun(d, o, res, t0, cpu0);
+    throw Interrupted(sig, "interrupted by " + signalName(sig) + ": " + std::to_string(have) + " of " +
+                               std::to_string(n) + " variations done" +
+                               (o.out_dir.empty() ? std::string()
+                                                  : ", in " + o.out_dir + "/results.csv (partial: true in "
+                                                    "sweep_stats.json and results.json); run again to resume"));
+  }
   finishSweepRun(d, o, res, t0, cpu0);
   return res;
 }

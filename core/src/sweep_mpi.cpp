@@ -101,7 +101,7 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   // --- manager (rank 0) ------------------------------------------------------------
   const int localThreads = size == 1 ? std::max(1, o.threads) : o.threads;
   const std::size_t n = d.variations.size();
-  std::FILE* journal = nullptr;
+  std::unique_ptr<AppendFile> journal;
   const std::vector<std::size_t> pending = prepareSweepRun(d, o, res, journal);
   std::deque<std::size_t> queue(pending.begin(), pending.end());
   const std::size_t pendingCount = queue.size();
@@ -110,11 +110,7 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   prog.total = n;
   prog.skipped = res.resumed;
   auto record = [&](SweepRow&& row) {  // manager thread only
-    if (journal) {
-      const std::string line = sweepJournalLine(d, row) + "\n";
-      if (std::fwrite(line.data(), 1, line.size(), journal) != line.size() || std::fflush(journal) != 0)
-        throw Error("cannot append to '" + o.out_dir + "/runs.jsonl'");
-    }
+    if (journal) journal->appendLine(sweepJournalLine(d, row));
     ++prog.done;
     if (!row.ok) ++prog.failed;
     res.rows[row.index] = std::move(row);
@@ -197,11 +193,11 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
       queue.clear();
     }
     for (auto& t : pool) t.join();
-    if (journal) std::fclose(journal);
+    journal.reset();
     throw;
   }
   for (auto& t : pool) t.join();
-  if (journal) std::fclose(journal);
+  if (journal) journal->close();
   MPI_Barrier(MPI_COMM_WORLD);  // every worker has had its -1; see the worker's barrier
   if (pendingCount == 0 && o.progress) o.progress(prog);
   res.workers = localThreads + size - 1;

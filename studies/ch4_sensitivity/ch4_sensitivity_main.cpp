@@ -150,7 +150,7 @@ int main(int argc, char** argv) {
       if (r.method == "reference") psi = r.psi;
     summary["psi"] = psi;
 
-    std::ofstream csv(out + "/sensitivity.csv");
+    OutputFile csv(out + "/sensitivity.csv");
     csv << "param,method,dpsi_db,rel_error\n";
     std::vector<std::vector<double>> relErrors(results.size());
     for (std::size_t k = 0; k < results.size(); ++k) {
@@ -180,7 +180,7 @@ int main(int argc, char** argv) {
         csv << mp[idx[i]].name << ',' << r.method << ',' << r.dpsi_db[i] << ','
             << (relErrors[k].empty() ? std::nan("") : relErrors[k][i]) << '\n';
     }
-    csv.close();
+    csv.commit();
     if (vehicle == "quarter_car" && relaxation) {
       // The seed's steady-slip tire for comparison (fd_central at the same accuracy).
       SensitivityProblem ps = prob;
@@ -195,7 +195,7 @@ int main(int argc, char** argv) {
     study::writeJson(out + "/summary.json", summary);
 
     if (!vm.count("no-plots") && reference && results.size() > 1) {
-      std::ofstream e(out + "/rel_error.csv");
+      OutputFile e(out + "/rel_error.csv");
       e << "param_index";
       for (std::size_t k = 0; k < results.size(); ++k)
         if (!relErrors[k].empty()) e << ',' << results[k].method;
@@ -206,7 +206,7 @@ int main(int argc, char** argv) {
           if (!relErrors[k].empty()) e << ',' << std::max(relErrors[k][i], 1e-16);
         e << '\n';
       }
-      e.close();
+      e.commit();
       study::PlotSpec p{out + "/rel_error.png", "d psi / d b: relative error against the reference (parameter 1.." +
                                                     std::to_string(idx.size()) + " in params order)",
                         "parameter", "relative error", {}};

@@ -148,12 +148,13 @@ int main(int argc, char** argv) {
     // --- Figure 6.2: linear law -------------------------------------------------
     const LinearBicycleParams lin = LinearBicycleParams::fromFile(vm["linear-data"].as<std::string>());
     {
-      std::ofstream f(out + "/linear_kr.csv");
+      OutputFile f(out + "/linear_kr.csv");
       f << "speed_m_s,kr\n";
       for (int i = 0; i <= 66; ++i) {
         const double U = 2.0 + 0.5 * i;
         f << U << ',' << calcLinearOptimalRatio(lin, U) << '\n';
       }
+      f.commit();
     }
     Json linearKr = Json::object();
     for (double U : {12.0, 16.0, 20.0, 25.0}) linearKr[formatValue(U)] = calcLinearOptimalRatio(lin, U);
@@ -286,7 +287,7 @@ int main(int argc, char** argv) {
 
     // --- outputs ----------------------------------------------------------------
     const std::string mapCsv = out + "/kr_map.csv";
-    std::ofstream f(mapCsv);
+    OutputFile f(mapCsv);
     f << "speed_m_s,front_deg,status,kr,linear_kr,side_slip_rad,yaw_rate_rad_s,lateral_acceleration_m_s2,stable,"
          "stability_checked,least_damped_real_per_s,kr_iterations,solves,newton_iterations,note\n";
     std::vector<RatioFit> fits;
@@ -350,25 +351,23 @@ int main(int argc, char** argv) {
       std::printf("  %6g %8.4f %10.3e %12.3e %9d %6d %11.2f %9.4f %7.2f\n", U, fit.c1, fit.c2_per_deg2,
                   fit.rms_residual, fit.points, infeasible, largest, linKr, run.wall_time_s);
     }
-    f.close();
+    f.commit();
     {
-      std::ofstream fc(out + "/kr_fit.csv");
+      OutputFile fc(out + "/kr_fit.csv");
       fc << "speed_m_s,c1,c2_per_deg2,rms_residual,points\n";
       for (const auto& x : fits) fc << x.speed_m_s << ',' << x.c1 << ',' << x.c2_per_deg2 << ',' << x.rms_residual << ',' << x.points << '\n';
+      fc.commit();
     }
     const std::string table = formatRatioTable(fits);
-    {
-      std::ofstream tf(out + "/kr_table.json");
-      if (!(tf << table)) throw Error("cannot write '" + out + "/kr_table.json'");
-    }
+    writeFileAtomic(out + "/kr_table.json", table);
     if (vm.count("table-copy")) {
       const std::string path = vm["table-copy"].as<std::string>();
-      std::ofstream tc(path);
-      if (!tc) throw Error("--table-copy: cannot write '" + path + "'");
+      OutputFile tc(path);
       tc << "// Kr(delta_f) = c1 + c2_per_deg2 delta_f^2 (8.1), delta_f in deg, App. A 4WS vehicle. Regenerate with\n"
             "//   ./build/bin/ch6_steering_ratio --table-copy vehicles/data/kr_table.json\n"
             "// (the same table, without these lines, is results/ch6_steering_ratio/kr_table.json).\n"
          << table;
+      tc.commit();
     }
     const double perSolve = solves ? double(newton) / solves : 0;
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

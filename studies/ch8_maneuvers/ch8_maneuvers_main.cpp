@@ -129,8 +129,7 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
 /// reference, front and rear steering (deg), Kr, lateral velocity, path error.
 void plotScenario(const std::string& png, const Scenario& sc, const std::string& refCsv,
                   const std::vector<std::pair<std::string, std::string>>& runs) {
-  std::ofstream g(png + ".gp");
-  if (!g) throw Error("cannot write '" + png + ".gp'");
+  OutputFile g(png + ".gp");
   g << "set terminal pngcairo size 1400,1300 font 'sans,10'\nset output '" << png << "'\n"
     << "set datafile separator ','\nset grid\nset key noenhanced\n"
     << "set multiplot layout 3,2 title '" << sc.id << ": " << sc.description << "' noenhanced\n";
@@ -160,7 +159,7 @@ void plotScenario(const std::string& png, const Scenario& sc, const std::string&
   panel("lateral velocity of the chassis (chassis frame)", "t (s)", "v_eta (m/s)", "column('t_s')",
         "column('chassis.lateral_speed_m_s')", false);
   g << "unset multiplot\n";
-  g.close();
+  g.commit();
   const std::string cmd = "gnuplot '" + png + ".gp' 2> '" + png + ".log'";
   if (std::system(cmd.c_str()) != 0) throw Error("gnuplot failed on '" + png + ".gp' (see " + png + ".log)");
   std::remove((png + ".log").c_str());

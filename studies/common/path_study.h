@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "vdyn/core/error.h"
+#include "vdyn/core/file_io.h"
 #include "vdyn/path/path.h"
 
 namespace vdyn::study {
@@ -29,12 +30,13 @@ inline double maxAbs(const std::vector<double>& x) { return calcErrorStats(x).ma
 
 /// Writes the reference path as CSV "x_m,y_m,heading_rad,curvature_per_m".
 inline void writePathCsv(const std::string& file, const ReferencePath& path, double lead_in_m, double lead_out_m) {
-  std::FILE* f = std::fopen(file.c_str(), "w");
-  if (!f) throw Error("cannot write '" + file + "'");
-  std::fprintf(f, "x_m,y_m,heading_rad,curvature_per_m\n");
-  for (const PathPoint& p : path.sample(lead_in_m, lead_out_m, 0.25))
-    std::fprintf(f, "%.9g,%.9g,%.9g,%.9g\n", p.p_G[0], p.p_G[1], p.heading_rad, p.curvature_per_m);
-  std::fclose(f);
+  std::string text = "x_m,y_m,heading_rad,curvature_per_m\n";
+  char line[160];
+  for (const PathPoint& p : path.sample(lead_in_m, lead_out_m, 0.25)) {
+    std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g\n", p.p_G[0], p.p_G[1], p.heading_rad, p.curvature_per_m);
+    text += line;
+  }
+  writeFileAtomic(file, text);
 }
 
 }  // namespace vdyn::study

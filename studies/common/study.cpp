@@ -10,9 +10,11 @@
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <sstream>
 #include <unistd.h>
 
 #include "vdyn/core/file_io.h"
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/plot.h"
 
 namespace vdyn::study {
@@ -26,6 +28,10 @@ int run(const std::string& study, const std::function<void()>& body) {
   try {
     body();
     return 0;
+  } catch (const Interrupted& e) {
+    // Stopped at a safe point by SIGINT/SIGTERM: one line, exit 128 + signal.
+    std::cerr << study << ": " << e.what() << std::endl;
+    return 128 + e.signal();
   } catch (const std::exception& e) {
     std::string msg = e.what();
     for (auto& c : msg)
@@ -107,7 +113,6 @@ void writeJson(const std::string& path, const Json& j) {
   if (summary) g_summaryWritten = true;
 }
 
-void writeFileAtomic(const std::string& path, const std::string& text) { vdyn::writeFileAtomic(path, text); }
 
 Given optionOr(const po::variables_map& vm, const std::string& option, const ParamReader& data, const std::string& key,
                double scale) {
@@ -204,8 +209,7 @@ void plot(const std::vector<PlotSpec>& plots) {
     throw Error("gnuplot not found: the PNG plots need it (apt-get install gnuplot-nox)");
   for (const PlotSpec& p : plots) {
     const std::string script = p.png + ".gp";
-    std::ofstream g(script);
-    if (!g) throw Error("cannot write '" + script + "'");
+    std::ostringstream g;
     g << "set terminal pngcairo size 1000,650 font 'sans,10'\n"
       << "set output " << gnuplotQuote(p.png) << "\n"
       << "set datafile separator ','\nset key autotitle columnhead\nset grid\n"
@@ -239,7 +243,7 @@ void plot(const std::vector<PlotSpec>& plots) {
         << gnuplotQuote(s.label);
     }
     g << "\n";
-    g.close();
+    writeFileAtomic(script, g.str());
     runGnuplot(script, p.png);
   }
 }

@@ -10,6 +10,7 @@
 #include <boost/program_options.hpp>
 #include <SimTKcommon.h>
 
+#include "vdyn/core/file_io.h"
 #include "vdyn/core/integrators.h"
 #include "vdyn/core/params.h"
 
@@ -79,8 +80,6 @@ std::string outputDir(const po::variables_map& vm, const std::string& study);
 /// renamed to `path` only when complete, so `path` is never half-written.
 /// A summary.json object without "completed" gets "completed": true.
 void writeJson(const std::string& path, const Json& j);
-/// Writes `text` to `path` the same way (temporary name, checked, renamed).
-void writeFileAtomic(const std::string& path, const std::string& text);
 
 /// One line series of a plot, read from a CSV file by column names.
 struct Series {

@@ -65,7 +65,7 @@ Json iso4138(const Config& c, const std::string& vehicle, const std::string& out
     set.radius_m = R;
     const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
     const std::string csv = out + "/iso4138_" + fileTag(vehicle) + "_R" + formatValue(R) + ".csv";
-    std::ofstream f(csv);
+    OutputFile f(csv);
     f << "speed_m_s,lateral_accel_m_s2,front_deg,rear_deg,side_slip_deg,roll_deg,yaw_rate_rad_s,"
          "understeer_gradient_deg_per_m_s2,delta_minus_l_over_R_deg,stable,least_damped_re_per_s,least_damped_im_per_s,"
          "iterations\n";
@@ -77,7 +77,7 @@ Json iso4138(const Config& c, const std::string& vehicle, const std::string& out
         << q.understeer_gradient_rad_per_m_s2 / kDeg << ',' << (q.front_rad - r.wheelbase_m / R) / kDeg << ','
         << int(q.stable) << ',' << q.least_damped.real() << ',' << q.least_damped.imag() << ',' << q.iterations << '\n';
     }
-    f.close();
+    f.commit();
     auto usAt = [&](double ay) {
       // Understeer gradient at a lateral acceleration (linear interpolation along the sweep).
       std::vector<double> x, y;
@@ -150,12 +150,13 @@ Json iso7401(const Config& c, const std::string& vehicle, const std::string& out
       logFrequencies(p.number("frequency_from_Hz"), p.number("frequency_to_Hz"), p.integer("frequency_count")));
   const std::string frCsv = out + "/iso7401_frequency_" + t + ".csv";
   {
-    std::ofstream f(frCsv);
+    OutputFile f(frCsv);
     f.precision(10);
     f << "frequency_Hz,yaw_gain_1_per_s,yaw_phase_deg,ay_gain_m_s2_per_rad,ay_phase_deg\n";
     for (const auto& q : fr.points)
       f << q.frequency_Hz << ',' << q.yaw_gain_1_per_s << ',' << q.yaw_phase_deg << ',' << q.ay_gain_m_s2_per_rad
         << ',' << q.ay_phase_deg << '\n';
+    f.commit();
   }
   Json j = {{"speed_m_s", set.speed_m_s},
             {"front_deg", st.front_rad / kDeg},

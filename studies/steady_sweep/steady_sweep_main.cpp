@@ -89,7 +89,7 @@ int main(int argc, char** argv) {
     };
 
     const std::string csv = out + "/sweep.csv";
-    std::ofstream f(csv);
+    OutputFile f(csv);
     f << "rear_ratio,speed_m_s,front_deg,rear_deg,status,path_radius_m,side_slip_rad,yaw_rate_rad_s,"
          "lateral_acceleration_m_s2,iterations,least_damped_real_per_s,least_damped_imag_per_s\n";
     const auto t0 = std::chrono::steady_clock::now();
@@ -175,7 +175,7 @@ int main(int argc, char** argv) {
       }
       byRatio.push_back({{"rear_ratio", kr}, {"speeds", rows}});
     }
-    f.close();
+    f.commit();
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     std::sort(iterations.begin(), iterations.end());
     const double median = iterations.empty() ? -1 : iterations[iterations.size() / 2];

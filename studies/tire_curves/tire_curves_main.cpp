@@ -54,12 +54,6 @@ std::string fmt(double v) {
   return buf;
 }
 
-std::ofstream openCsv(const std::string& path, const std::string& header) {
-  std::ofstream out(path);
-  if (!out) throw Error("cannot write '" + path + "'");
-  out << header << '\n';
-  return out;
-}
 
 /// Column name of one (model, load) series in the wide plot helpers.
 std::string seriesName(const std::string& model, double Fz) { return model + "_Fz" + fmt(Fz) + "_N"; }
@@ -107,7 +101,8 @@ int main(int argc, char** argv) {
     std::map<std::string, std::map<double, Peak>> peakFy, peakFx;
     std::vector<std::vector<double>> latWide(kAlphaPoints);
     {
-      std::ofstream csv = openCsv(out + "/lateral.csv", "model,Fz_N,alpha_rad,Fy_N");
+      OutputFile csv(out + "/lateral.csv");
+      csv << "model,Fz_N,alpha_rad,Fy_N" << '\n';
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N)
           for (int i = 0; i < kAlphaPoints; ++i) {
@@ -117,12 +112,13 @@ int main(int argc, char** argv) {
             latWide[i].push_back(Fy);
             peakFy[name][Fz].update(std::abs(Fy), alpha);
           }
-      if (!csv) throw Error("error writing '" + out + "/lateral.csv'");
+      csv.commit();
     }
     // --- Pure longitudinal slip ---------------------------------------------------------
     std::vector<std::vector<double>> lonWide(kKappaPoints);
     {
-      std::ofstream csv = openCsv(out + "/longitudinal.csv", "model,Fz_N,slip_ratio,Fx_N");
+      OutputFile csv(out + "/longitudinal.csv");
+      csv << "model,Fz_N,slip_ratio,Fx_N" << '\n';
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N)
           for (int i = 0; i < kKappaPoints; ++i) {
@@ -132,13 +128,14 @@ int main(int argc, char** argv) {
             lonWide[i].push_back(Fx);
             peakFx[name][Fz].update(std::abs(Fx), kappa);
           }
-      if (!csv) throw Error("error writing '" + out + "/longitudinal.csv'");
+      csv.commit();
     }
     // --- Combined slip at 4000 N ----------------------------------------------------------
     std::vector<std::vector<double>> comboWide(kKappaPoints);
     Json combinedSummary = Json::object();
     {
-      std::ofstream csv = openCsv(out + "/combined.csv", "model,Fz_N,slip_ratio,alpha_rad,Fx_N,Fy_N");
+      OutputFile csv(out + "/combined.csv");
+      csv << "model,Fz_N,slip_ratio,alpha_rad,Fx_N,Fy_N" << '\n';
       for (const std::string& name : kModels)
         for (double alpha : kCombinedAlphas_rad) {
           double maxResultant = 0;
@@ -153,14 +150,15 @@ int main(int argc, char** argv) {
           }
           combinedSummary[name]["alpha_" + fmt(alpha) + "_rad"] = {{"max_resultant_over_Fz", maxResultant}};
         }
-      if (!csv) throw Error("error writing '" + out + "/combined.csv'");
+      csv.commit();
     }
     // Wide helpers for the plots (study::plot filters on one column only).
     {
       std::string head = "alpha_rad";
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N) head += "," + seriesName(name, Fz);
-      std::ofstream csv = openCsv(out + "/lateral_plot.csv", head);
+      OutputFile csv(out + "/lateral_plot.csv");
+      csv << head << '\n';
       for (int i = 0; i < kAlphaPoints; ++i) {
         csv << fmt(alphaAt(i));
         for (double v : latWide[i]) csv << ',' << fmt(v);
@@ -169,7 +167,8 @@ int main(int argc, char** argv) {
       head = "slip_ratio";
       for (const std::string& name : kModels)
         for (double Fz : kLoads_N) head += "," + seriesName(name, Fz);
-      std::ofstream csv2 = openCsv(out + "/longitudinal_plot.csv", head);
+      OutputFile csv2(out + "/longitudinal_plot.csv");
+      csv2 << head << '\n';
       for (int i = 0; i < kKappaPoints; ++i) {
         csv2 << fmt(kappaAt(i));
         for (double v : lonWide[i]) csv2 << ',' << fmt(v);
@@ -180,7 +179,8 @@ int main(int argc, char** argv) {
         for (double alpha : kCombinedAlphas_rad)
           head += "," + comboName(name, alpha, "Fx_N") + "," + comboName(name, alpha, "Fy_N");
       head += ",circle_mu_max_Fx_N,circle_mu_max_Fy_N,circle_mu_min_Fx_N,circle_mu_min_Fy_N";
-      std::ofstream csv3 = openCsv(out + "/combined_plot.csv", head);
+      OutputFile csv3(out + "/combined_plot.csv");
+      csv3 << head << '\n';
       for (int i = 0; i < kKappaPoints; ++i) {
         csv3 << fmt(kappaAt(i));
         for (double v : comboWide[i]) csv3 << ',' << fmt(v);
@@ -189,7 +189,9 @@ int main(int argc, char** argv) {
           csv3 << ',' << fmt(mu * kCombinedLoad_N * std::cos(th)) << ',' << fmt(mu * kCombinedLoad_N * std::sin(th));
         csv3 << '\n';
       }
-      if (!csv || !csv2 || !csv3) throw Error("error writing the plot helper CSVs in '" + out + "'");
+      csv.commit();
+      csv2.commit();
+      csv3.commit();
     }
 
     // --- Slopes at zero slip (central differences around free rolling) ----------------

@@ -11,7 +11,8 @@ int checkCommand(const std::vector<std::string>& args) {
   namespace po = study::po;
   po::options_description opts("Options");
   opts.add_options()("scene", po::value<std::string>(), "scene file")(
-      "set", po::value<std::vector<std::string>>()->composing(), "override a scene value: key.path=value");
+      "set", po::value<std::vector<std::string>>()->composing(), "override a scene value: key.path=value")(
+      "resolved", "print the resolved scene (based_on merged, --set applied) and its plugin list, then check it");
   addCommonOptions(opts);
   po::variables_map vm;
   if (!parseArgs(command("check"), args, opts, {"scene"}, vm)) return 0;
@@ -21,6 +22,16 @@ int checkCommand(const std::vector<std::string>& args) {
   if (vm.count("set"))
     for (const auto& s : vm["set"].as<std::vector<std::string>>()) overrides.push_back(Override::parse(s, "--set"));
   const SceneDescription scene = SceneDescription::fromFile(vm["scene"].as<std::string>(), registry, overrides);
+  if (vm.count("resolved")) {
+    const Json& j = scene.json();
+    std::printf("%s\n", j.dump(2).c_str());
+    std::printf("vdyn check: %s: plugins:", scene.path().c_str());
+    if (j.contains("plugins") && j["plugins"].is_array())
+      for (const Json& p : j["plugins"])
+        std::printf(" %s (%s)", p.is_object() ? p.value("name", std::string("?")).c_str() : "?",
+                    p.is_object() ? p.value("type", std::string("?")).c_str() : "?");
+    std::printf("\n");
+  }
   std::vector<std::string> errors;
   try {
     loadSceneLibraries(scene, registry);

@@ -3,6 +3,7 @@
 #include <iostream>
 
 #include "command.h"
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/scene_file.h"
 
 namespace vdyn::cli {
@@ -30,7 +31,13 @@ int runCommand(const std::vector<std::string>& args) {
   options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : defaultOutputDir(scene);
   options.progress = [](const std::string& label, double tEnd) { return study::progress(label, tEnd); };
   options.plots = !vm.count("no-plots");
-  const Json summary = runScene(scene, options);
+  installInterruptHandlers();  // SIGINT/SIGTERM: a transient stops at its next step, nothing is written
+  Json summary;
+  try {
+    summary = runScene(scene, options);
+  } catch (const Interrupted& e) {
+    throw Interrupted(e.signal(), std::string(e.what()) + "; nothing written to " + options.out_dir);
+  }
   study::endProgress();
   std::printf("vdyn run: %s (%s): %s/summary.json\n", scene.name().c_str(),
               summary.value("analysis", std::string("?")).c_str(), options.out_dir.c_str());

@@ -14,9 +14,12 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <thread>
 
 #include "command.h"
+#include "vdyn/core/file_io.h"
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/key_path.h"
 #include "vdyn/core/plot.h"
 #include "vdyn/core/scene_file.h"
@@ -71,8 +74,7 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
     const auto panels = distinct(p.panels), series = distinct(p.series);
     const int cols = int(std::ceil(std::sqrt(double(panels.size()))));
     const int rows = int((panels.size() + cols - 1) / cols);
-    std::ofstream g(script);
-    if (!g) throw Error("cannot write '" + script + "'");
+    std::ostringstream g;
     g << "set terminal pngcairo size " << 640 * cols << "," << 480 * rows + 40 << " font 'sans,9'\n"
       << "set output " << gnuplotQuote(png) << "\nset datafile separator ','\nset grid\nset key noenhanced\n"
       << "set xlabel " << gnuplotQuote(p.x_label.empty() ? p.x : p.x_label) << " noenhanced\n"
@@ -99,7 +101,7 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
       g << "\n";
     }
     if (panels.size() > 1 || !p.title.empty()) g << "unset multiplot\n";
-    g.close();
+    writeFileAtomic(script, g.str());
     runGnuplot(script, png);
   }
 }
@@ -130,7 +132,7 @@ int sweepCommand(const std::vector<std::string>& args) {
 
   // Everything a run needs is loaded and checked before any run (and before
   // threads start: plugin libraries change the registry).
-  const SweepDescription sweep = SweepDescription::fromFile(vm["sweep"].as<std::string>());
+  const SweepDescription sweep = SweepDescription::fromFile(resolveDataPath(vm["sweep"].as<std::string>()));
   PluginRegistry& registry = registryWithPlugins(vm);
   const SceneDescription base = SceneDescription::fromFile(sweep.scene, registry, toOverrides(sweep.common));
   loadSceneLibraries(base, registry);
@@ -179,6 +181,7 @@ int sweepCommand(const std::vector<std::string>& args) {
   } else {
     so.threads = vm.count("threads") ? vm["threads"].as<int>() : int(std::max(1u, std::thread::hardware_concurrency()));
     if (!quiet) so.progress = sweepProgressPrinter("vdyn sweep");
+    installInterruptHandlers();  // SIGINT/SIGTERM: stop between variations, write the finished rows
     r = runSweep(sweep, run, so);
     if (!vm.count("no-plots")) renderPlots(sweep, r, out);
   }

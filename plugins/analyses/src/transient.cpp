@@ -40,6 +40,9 @@ TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, 
   for (const auto& name : settings.integrals_of_square) handles.push_back(scene.addIntegralOfSquare(name));
   TransientRun r;
   r.final_state = built.makeInitialState();
+  // Named before the solver (else a failed velocity projection): a plugin the
+  // initial state contradicts, e.g. a speed hold at another speed.
+  for (const auto& p : built.scene().getPlugins()) p->checkInitialState(built.scene(), r.final_state);
   r.vehicle = built.vehicle->describe(r.final_state);
   if (!built.outputs.empty()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
   const SimulationSettings sim = settings.simulation();

@@ -6,6 +6,8 @@
 #include <fstream>
 #include <limits>
 
+#include "vdyn/core/file_io.h"
+
 namespace vdyn {
 
 using SimTK::Vec3;
@@ -135,14 +137,14 @@ double solveSteeringForLateralAcceleration(const HandlingVehicle& v, double U, d
 }
 
 void HandlingHistory::writeCsv(const std::string& path) const {
-  std::ofstream f(path);
-  if (!f) throw Error("cannot write '" + path + "'");
+  OutputFile f(path);
   f << "t_s,front_rad,rear_rad,yaw_rate_rad_s,lateral_accel_m_s2,x_m,y_m,yaw_rad,side_slip_rad,roll_rad\n";
   f.precision(10);
   for (std::size_t i = 0; i < t_s.size(); ++i)
     f << t_s[i] << ',' << front_rad[i] << ',' << rear_rad[i] << ',' << yaw_rate_rad_s[i] << ','
       << lateral_accel_m_s2[i] << ',' << x_m[i] << ',' << y_m[i] << ',' << yaw_rad[i] << ',' << side_slip_rad[i] << ','
       << roll_rad[i] << '\n';
+  f.commit();
 }
 
 HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double t_end, double sample,

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "vdyn/core/file_io.h"
 #include "vdyn/core/recorder.h"
 #include "vdyn/handling/handling.h"
 #include "vdyn/path_control/path_control.h"
@@ -191,13 +192,13 @@ BodyOutline VehicleFootprint::body(const Iso3888Settings& s) const {
 }
 
 void Iso3888Run::writeCsv(const std::string& path) const {
-  std::ofstream f(path);
-  if (!f) throw Error("cannot write '" + path + "'");
+  OutputFile f(path);
   f << "t_s,x_m,y_m,yaw_rad,front_rad,rear_rad,path_error_m\n";
   f.precision(10);
   for (std::size_t i = 0; i < t_s.size(); ++i)
     f << t_s[i] << ',' << x_m[i] << ',' << y_m[i] << ',' << yaw_rad[i] << ',' << front_rad[i] << ',' << rear_rad[i]
       << ',' << path_error_m[i] << '\n';
+  f.commit();
 }
 
 namespace {

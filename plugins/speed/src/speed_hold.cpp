@@ -1,5 +1,8 @@
 #include "vdyn/speed/speed_hold.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "vdyn/core/fields.h"
 
 namespace vdyn {
@@ -82,6 +85,20 @@ void SpeedHoldPlugin::DoAddTo(Scene& scene) {
   const SpeedHoldPlugin* self = this;
   scene.addOutput({name() + ".force_N", "N", SimTK::Stage::Acceleration,
                    [self](const SimTK::State& s) { return self->calcForce(s); }});
+}
+
+void SpeedHoldPlugin::DoCheckInitialState(const Scene& scene, const SimTK::State& initial) const {
+  scene.getSystem().realize(initial, SimTK::Stage::Velocity);
+  // The chassis' forward speed in its own x-y plane (what (3.18) holds).
+  const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
+  const SimTK::Rotation& R = chassis.getBodyRotation(initial);
+  const Vec3& v = chassis.getBodyOriginVelocity(initial);
+  const double U = std::hypot(SimTK::dot(R.x(), v), SimTK::dot(R.y(), v));
+  const double held = getSpeed(initial);
+  if (std::abs(U - held) > 1e-6 * std::max(1.0, held))
+    throw Error("speed_hold '" + name() + "': speed_m_s = " + formatValue(held) + " m/s differs from the vehicle's initial speed " + formatValue(U) +
+                " m/s (vehicle.initial_speed_m_s): a speed hold cannot change the speed at t = 0; set both to the "
+                "same value");
 }
 
 double SpeedHoldPlugin::getSpeed(const SimTK::State& s) const {

@@ -28,6 +28,16 @@ Json readJsonFile(const std::string& path);
 /// Parses JSON text; `name` names the source in messages (as readJsonFile).
 Json parseJsonText(const std::string& text, const std::string& name);
 
+/// Bounds on what the JSON readers accept (bounded input: a hostile or broken
+/// file is a named Error, not a crash or an exhausted memory). No scene, data
+/// or sweep file nests deeper than about 8 levels.
+constexpr std::size_t kMaxJsonDepth = 100;                   ///< nested arrays/objects
+constexpr std::size_t kMaxJsonFileBytes = 64u * 1024 * 1024;  ///< 64 MiB per file
+/// Throws Error naming `name`, the depth reached, where it first passes
+/// kMaxJsonDepth (line, column) and the limit, when `text` nests deeper
+/// (brackets inside strings and comments are not counted).
+void requireJsonDepth(const std::string& text, const std::string& name);
+
 /// The folders a data-file name is looked up in when it is not an existing
 /// path, in order: each folder of the environment variable VDYN_DATA_PATH
 /// (':'-separated, read at every call), then the installed data folder

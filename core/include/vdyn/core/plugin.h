@@ -40,6 +40,13 @@ class Plugin {
   /// plugin's own state, if any).
   void initialize(const Scene& scene, SimTK::State& state) const;
 
+  /// What can be known before a run: throws Error (naming the plugin's key and
+  /// the vehicle's) if the vehicle's initial state contradicts the plugin, e.g.
+  /// a speed hold whose speed differs from vehicle.initial_speed_m_s, which the
+  /// solver could only report as a failed velocity projection. Called by
+  /// `vdyn check` and before `vdyn run` on the built scene's initial state.
+  void checkInitialState(const Scene& scene, const SimTK::State& initial) const { DoCheckInitialState(scene, initial); }
+
   /// Scalars the plugin lets analyses change without rebuilding the scene (a
   /// continuation's driving condition), e.g. speed hold "speed_m_s", a held
   /// steering command "angle_rad".
@@ -53,6 +60,7 @@ class Plugin {
   Plugin(PluginKind kind, std::string type, std::string name);
   virtual void DoAddTo(Scene& scene) = 0;
   virtual void DoInitialize(const Scene&, SimTK::State&) const {}
+  virtual void DoCheckInitialState(const Scene&, const SimTK::State&) const {}
   virtual std::vector<std::string> DoGetAdjustables() const { return {}; }
   virtual void DoSetAdjustable(SimTK::State&, const std::string&, double) const {}
 

@@ -26,12 +26,18 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <memory>
 #include <string>
 #include <vector>
 
+#include "vdyn/core/file_io.h"
 #include "vdyn/core/params.h"
 
 namespace vdyn {
+
+/// The most variations a sweep file may describe (checked before any is
+/// built: a grid's size is the product of its axes' counts).
+constexpr std::size_t kMaxSweepVariations = 1000000;
 
 /// One changed setting: a KeyPath into the scene ("a.b[2].c", vdyn/core/key_path.h) and its value.
 struct SweepSetting {
@@ -193,6 +199,10 @@ struct SweepResult {
   double cpu_s = 0;            ///< process CPU time of this session (all threads)
   int workers = 0;             ///< threads or ranks that ran variations
   std::string runner;          ///< "threads" or "mpi"
+  /// Stopped by SIGINT/SIGTERM (thread runner): `rows` holds only the finished
+  /// variations, and results.json and sweep_stats.json say "partial": true.
+  bool partial = false;
+  std::string interrupted_by;  ///< "SIGINT", "SIGTERM" when partial
 };
 
 /// Runs the sweep on `options.threads` threads (dynamic: one variation at a
@@ -210,14 +220,14 @@ SweepRow parseSweepJournalLine(const SweepDescription& d, const std::string& lin
 std::vector<SweepRow> readSweepJournal(const SweepDescription& d, const std::string& dir);
 /// Opens `dir`/runs.jsonl for appending (resume) or anew; a last line without
 /// its line break gets one first.
-std::FILE* openSweepJournal(const std::string& dir, bool append);
+std::unique_ptr<AppendFile> openSweepJournal(const std::string& dir, bool append);
 /// Prepares a run of `d` for either runner: sizes `res.rows`, creates `o.out_dir`,
 /// takes the rows already in its journal (o.resume; failed ones again if
 /// o.retry_failed) into `res.rows` and `res.resumed`, and opens the journal into
-/// `journal` (nullptr when o.out_dir is ""). Returns the variation indices still to run,
+/// `journal` (null when o.out_dir is ""). Returns the variation indices still to run,
 /// ascending.
 std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
-                                         std::FILE*& journal);
+                                         std::unique_ptr<AppendFile>& journal);
 /// Ends a run of either runner: counts the failed rows into `res.failed`, sets
 /// `res.wall_s` and `res.cpu_s` (since `start` and processCpuSeconds() = `cpu0`)
 /// and writes the outputs into o.out_dir (writeSweepOutputs; none when "").

@@ -74,6 +74,9 @@ class SpeedHoldPlugin : public ConstraintPlugin {
 
  protected:
   void DoAddTo(Scene& scene) override;
+  /// The vehicle's initial speed must be the held speed (else the first
+  /// velocity projection fails): a named Error instead.
+  void DoCheckInitialState(const Scene& scene, const SimTK::State& initial) const override;
   /// "speed_m_s" (setSpeed).
   std::vector<std::string> DoGetAdjustables() const override { return {"speed_m_s"}; }
   void DoSetAdjustable(SimTK::State& state, const std::string&, double value) const override { setSpeed(state, value); }
