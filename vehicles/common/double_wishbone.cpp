@@ -131,10 +131,7 @@ DoubleWishboneParams DoubleWishboneParams::fromParams(const ParamReader& r) {
   return p;
 }
 
-namespace {
-/// A body of the hardpoint form: mass, inertia (about its c.m., chassis axes)
-/// and its c.m. in the chassis frame.
-RigidBodyParams hardpointBody(const ParamReader& r, Vec3* com) {
+RigidBodyParams readHardpointBody(const ParamReader& r, Vec3* com) {
   RigidBodyParams b;
   b.mass_kg = r.number("mass_kg");
   b.inertia_kg_m2 = r.vec3("inertia_kg_m2");
@@ -142,7 +139,11 @@ RigidBodyParams hardpointBody(const ParamReader& r, Vec3* com) {
   *com = r.vec3("com_m");
   return b;
 }
-}  // namespace
+
+SimTK::UnitVec3 calcSpinAxisFromCamberToe(double camber, double toe, bool right) {
+  const double c = std::cos(camber), s = std::sin(camber), st = std::sin(toe), ct = std::cos(toe);
+  return right ? SimTK::UnitVec3(Vec3(-c * st, c * ct, s)) : SimTK::UnitVec3(Vec3(c * st, c * ct, -s));
+}
 
 DoubleWishboneParams DoubleWishboneParams::fromHardpoints(const ParamReader& r) {
   DoubleWishboneParams p;
@@ -152,9 +153,9 @@ DoubleWishboneParams DoubleWishboneParams::fromHardpoints(const ParamReader& r) 
   const Vec3 spindle = h.vec3("spindle");
   const ParamReader b = r.child("bodies");
   Vec3 cl, cu, ck;
-  p.lower_arm = hardpointBody(b.child("lower_arm"), &cl);
-  p.upper_arm = hardpointBody(b.child("upper_arm"), &cu);
-  p.knuckle = hardpointBody(b.child("knuckle"), &ck);
+  p.lower_arm = readHardpointBody(b.child("lower_arm"), &cl);
+  p.upper_arm = readHardpointBody(b.child("upper_arm"), &cu);
+  p.knuckle = readHardpointBody(b.child("knuckle"), &ck);
   p.knuckle.com_m = ck - spindle;  // the knuckle frame's origin is the wheel centre
   p.wheel = RigidBodyParams::fromParams(b.child("wheel"));
   auto revolute = [](const Vec3& a, const Vec3& axisPoint, const Vec3& com) {
@@ -177,8 +178,7 @@ DoubleWishboneParams DoubleWishboneParams::fromHardpoints(const ParamReader& r) 
   p.upper_ball = ball(uu, cu, spindle);
   p.upper_pivot = revolute(uf, ub, cu);
   const double camber = r.numberOr("camber_rad", 0), toe = r.numberOr("toe_in_rad", 0);
-  // The right wheel's spin axis pointing left (+eta) from camber (+ top out) and toe (+ in).
-  p.wheel_spin_axis = Vec3(-std::cos(camber) * std::sin(toe), std::cos(camber) * std::cos(toe), std::sin(camber));
+  p.wheel_spin_axis = calcSpinAxisFromCamberToe(camber, toe, true).asVec3();  // the right wheel's
   const ParamReader s = r.child("spring");
   p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
   p.damper_N_s_per_m = s.number("damping_N_s_per_m");

@@ -29,6 +29,17 @@ struct RigidBodyParams {
   static RigidBodyParams fromParams(const ParamReader& r);
 };
 
+/// A body of a hardpoint-form template: {mass_kg, inertia_kg_m2 (about its
+/// c.m., chassis axes), com_m (its c.m. in the chassis frame at design)}; the
+/// c.m. is returned in `com_chassis_m`, the body's com_m stays 0.
+RigidBodyParams readHardpointBody(const ParamReader& r, SimTK::Vec3* com_chassis_m);
+
+/// The wheel's spin axis at design in the chassis frame, pointing to the
+/// vehicle's left (+eta) on either side, from static camber (+ top of the
+/// wheel outward) and toe (+ toe-in): the outward axis s_out has
+/// s_out . z = -sin(camber) and toe-in = atan2(s_out . x, s_out . y_out).
+SimTK::UnitVec3 calcSpinAxisFromCamberToe(double camber_rad, double toe_in_rad, bool right);
+
 /// A Simbody rigid body with its centre of mass at the body origin.
 SimTK::Body::Rigid makeRigidBody(const RigidBodyParams& b);
 

@@ -18,10 +18,7 @@ SimTK::Transform zFrame(const Vec3& point, const SimTK::UnitVec3& axis) {
 
 HardpointBody readBody(const ParamReader& r) {
   HardpointBody b;
-  b.body.mass_kg = r.number("mass_kg");
-  b.body.inertia_kg_m2 = r.vec3("inertia_kg_m2");
-  b.body.validate(r.where());
-  b.com_m = r.vec3("com_m");
+  b.body = readHardpointBody(r, &b.com_m);
   return b;
 }
 
@@ -115,11 +112,7 @@ MacPhersonStrutParams MacPhersonStrutParams::mirrored() const {
 }
 
 SimTK::UnitVec3 MacPhersonStrutParams::calcSpinAxis(bool right) const {
-  // The outward spin axis s_out has s_out . z = -sin(camber) and, in the
-  // horizontal plane, toe-in = atan2(s_out . x, s_out . y_out); the axis
-  // pointing left is -s_out on the right and s_out on the left.
-  const double c = std::cos(camber_rad), s = std::sin(camber_rad), st = std::sin(toe_in_rad), ct = std::cos(toe_in_rad);
-  return right ? SimTK::UnitVec3(Vec3(-c * st, c * ct, s)) : SimTK::UnitVec3(Vec3(c * st, c * ct, -s));
+  return calcSpinAxisFromCamberToe(camber_rad, toe_in_rad, right);
 }
 
 MacPhersonStrutSuspension::MacPhersonStrutSuspension(const MacPhersonStrutParams& right)
