@@ -110,8 +110,8 @@ const FieldTable<DoubleWishboneParams>& DoubleWishboneParams::fields() {
                                       "parent_axis_point_m": [1.38, -0.34, -0.215],
                                       "child_axis_point_m": [0.1, 0.105, -0.027]}})")
           .custom("spring", "-", "required",
-                  "stiffness_N_per_m, damping_N_s_per_m, free_length_m, chassis_point_m (chassis frame), "
-                  "arm_point_m (lower arm frame, default 0)",
+                  (std::string("stiffness_N_per_m, damping_N_s_per_m, free_length_m, chassis_point_m (chassis frame), "
+                               "arm_point_m (lower arm frame, default 0)") + SpringStopParams::fieldMeaning()).c_str(),
                   [](const ParamReader& r, P& p) {
                     const ParamReader s = r.child("spring");
                     p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
@@ -119,6 +119,7 @@ const FieldTable<DoubleWishboneParams>& DoubleWishboneParams::fields() {
                     p.spring_free_length_m = s.number("free_length_m");
                     p.spring_chassis_point_m = s.vec3("chassis_point_m");
                     p.spring_arm_point_m = s.vec3Or("arm_point_m", Vec3(0));
+                    p.stops = SpringStopParams::fromSpringBlock(s);
                   })
           .sample(R"({"stiffness_N_per_m": 9.16e4, "damping_N_s_per_m": 1.44e4, "free_length_m": 0.344,
                       "chassis_point_m": [1.31, -0.395, -0.1]})");
@@ -183,6 +184,7 @@ DoubleWishboneParams DoubleWishboneParams::fromHardpoints(const ParamReader& r) 
   p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
   p.damper_N_s_per_m = s.number("damping_N_s_per_m");
   p.spring_free_length_m = s.number("free_length_m");
+  p.stops = SpringStopParams::fromSpringBlock(s);
   p.spring_chassis_point_m = h.vec3("spring_chassis");
   p.spring_arm_point_m = h.vec3("spring_arm") - cl;
   if (h.has("damper_chassis") || h.has("damper_arm")) {

@@ -131,6 +131,10 @@ const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
                     if (r.has("road")) p.road = RoadParams::fromParams(r.child("road"));
                   })
           .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
+          .boolean("spring_free_length_from_ride_height", &P::spring_free_length_from_ride_height,
+                   "true: every corner spring's free length is set so that the vehicle at rest sits at its "
+                   "tabulated (design) configuration, each spring at its design length; the data's free lengths are "
+                   "the start")
           .string("forward_dynamics", &P::forward_dynamics,
                   "simbody | dense (every axle double_wishbone_reduced: the constraint rows solved as one dense "
                   "system)");
@@ -152,7 +156,8 @@ WheeledVehicleParams WheeledVehicleParams::fromFile(const std::string& path, con
 WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params) : WheeledVehicle(params, vehiclePlugins()) {}
 
 WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginRegistry& registry)
-    : p_(params), scene_(std::make_unique<Scene>()) {
+    : p_(params.spring_free_length_from_ride_height ? params.withRideHeightSprings(registry) : params),
+      scene_(std::make_unique<Scene>()) {
   p_.validate();
   Scene& sc = *scene_;
   SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);

@@ -15,6 +15,7 @@
 #include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 #include "vdyn/core/scene.h"
+#include "vdyn/vehicles/spring_stops.h"
 
 namespace vdyn {
 
@@ -67,6 +68,8 @@ struct DoubleWishboneParams {
   double spring_free_length_m = 0.344;
   SimTK::Vec3 spring_chassis_point_m{1.31, -0.395, -0.10};
   SimTK::Vec3 spring_arm_point_m{0, 0, 0};  ///< on the lower arm
+  /// Bump and rebound stops along the spring's line (data "spring": {"bump_stop", "rebound_stop"}; none by default).
+  SpringStopParams stops;
   /// The damper's own points (chassis frame; lower arm frame); App. A's damper
   /// shares the spring's points (separate_damper false).
   bool separate_damper = false;

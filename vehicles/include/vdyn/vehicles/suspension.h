@@ -29,6 +29,7 @@
 #include "vdyn/core/scene.h"
 #include "vdyn/tire/tire_model.h"
 #include "vdyn/vehicles/reduced_dense.h"
+#include "vdyn/vehicles/spring_stops.h"
 
 namespace vdyn {
 
@@ -96,6 +97,13 @@ class Suspension {
   /// The built corner for a kinematics sweep; false if the template has no
   /// such description (the vehicle report then names it).
   virtual bool getKinematicCorner(int /*side*/, KinematicCorner* /*k*/) const { return false; }
+  /// The length of side's spring in s, m: the distance between its two mounts
+  /// (what the ride-height option holds at design and the stops act on).
+  /// Throws Error naming the template if it registered no spring mount.
+  double calcSpringLength(const SimTK::State& s, int side) const;
+  /// True if the built template registered its springs' mounts.
+  bool hasSpringMounts() const { return mounts_[0].valid && mounts_[1].valid; }
+
   /// Largest separation of a loop's cut joint in s before assembly, m (0 for
   /// a loop closed by construction).
   virtual double calcLoopGap(const SimTK::State& /*s*/, int /*side*/) const { return 0; }
@@ -122,8 +130,23 @@ class Suspension {
   virtual void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) = 0;
   virtual void DoShiftChassisFrame(const SimTK::Vec3& offset_m) = 0;
 
+  /// A spring's two mounts: a station on each of two bodies (body frames, m).
+  struct SpringMount {
+    bool valid = false;
+    SimTK::MobilizedBody a, b;
+    SimTK::Vec3 p_a{0}, p_b{0};
+  };
+  /// Called by DoBuildCorner: registers side's spring mounts (a on the
+  /// chassis side, b on the suspension) and adds the corner's stops along the
+  /// same line, with the outputs <prefix>spring_length_m (m),
+  /// <prefix>bump_stop_N and <prefix>rebound_stop_N (N, + compressing the
+  /// stop) when it has any.
+  void addSpringMount(Scene& scene, int side, const std::string& prefix, const SpringMount& mount,
+                      const SpringStopParams& stops);
+
  private:
   std::string template_;
+  SpringMount mounts_[2];
   std::map<std::string, SimTK::MobilizedBody> bodies_[2];  ///< by role, filled by build()
 };
 

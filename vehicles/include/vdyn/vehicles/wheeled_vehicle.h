@@ -83,6 +83,14 @@ struct WheeledVehicleParams {
   /// control; time-commanded steering only; see reduced_dense.h).
   /// makeInitialState and makeStateLike return dense states.
   std::string forward_dynamics = "simbody";
+  /// Data key "spring_free_length_from_ride_height" (default false; the
+  /// quarter car's key): true sets every corner spring's free length (its
+  /// suspension block's spring.free_length_m, and its "left" block's) so that
+  /// the vehicle at rest sits at its tabulated configuration, the design ride
+  /// height: each spring at its design length, the chassis level in roll and
+  /// pitch as its tires' deflections leave it. The data's free lengths are the
+  /// start. The vehicle does it when built (withRideHeightSprings).
+  bool spring_free_length_from_ride_height = false;
 
   void validate() const;
   /// The axle named `name`; throws Error listing the axles.
@@ -95,6 +103,25 @@ struct WheeledVehicleParams {
   /// The suspension templates come from `registry` (default vehiclePlugins()).
   static WheeledVehicleParams fromParams(const ParamReader& r, const PluginRegistry* registry = nullptr);
   static WheeledVehicleParams fromFile(const std::string& path, const PluginRegistry* registry = nullptr);
+
+  /// What withRideHeightSprings did.
+  struct RideHeightReport {
+    int iterations = 0;            ///< static equilibria solved
+    double max_length_error_m = 0; ///< largest |spring length at rest - design length| at the end, m
+    /// Free lengths set, m, corner by corner (c = 2 axle + side).
+    std::vector<double> free_length_m;
+  };
+  /// A copy with spring_free_length_from_ride_height false and every spring's
+  /// free length set for the design ride height (see the key): a fixed point on
+  /// the vehicle's static equilibrium (the steady-state solver at zero speed,
+  /// steerable axles held straight), l0 <- l0 + (L_design - l_rest), until the
+  /// rest lengths are within 1e-9 m of design (each axle whose left corner is
+  /// the mirror keeps one free length: the mean of its sides' updates). An axle
+  /// whose template starts from another's assembly is solved on that one (the
+  /// reduced double wishbone on the constrained). Throws Error naming the axle
+  /// if its block has no spring.free_length_m, a free length would not be
+  /// positive, or it does not converge in 20 equilibria.
+  WheeledVehicleParams withRideHeightSprings(const PluginRegistry& registry, RideHeightReport* report = nullptr) const;
 };
 
 class WheeledVehicle {

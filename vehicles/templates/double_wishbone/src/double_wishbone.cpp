@@ -146,9 +146,22 @@ bool DoubleWishboneSuspension::getKinematicCorner(int side, KinematicCorner* k) 
   return true;
 }
 
+Suspension::SpringMount DoubleWishboneSuspension::springMount(const SimTK::MobilizedBody& chassis,
+                                                             const SimTK::MobilizedBody& lowerArm,
+                                                             const DoubleWishboneParams& p) {
+  SpringMount m;
+  m.a = chassis;
+  m.p_a = p.spring_chassis_point_m;
+  m.b = lowerArm;
+  m.p_b = p.spring_arm_point_m;
+  return m;
+}
+
 void DoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side,
                                              const std::string& prefix) {
   corners_[side] = buildDoubleWishbone(scene, chassis, params_[side], prefix);
+  addSpringMount(scene, side, prefix, springMount(chassis, corners_[side].lower_arm, params_[side]),
+                 params_[side].stops);
 }
 
 // --- double_wishbone_reduced -------------------------------------------------
@@ -164,6 +177,8 @@ void ReducedDoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::Mobiliz
                                                     const std::string& prefix) {
   loops_[side] = std::make_unique<WishboneLoop>(params_[side]);
   reduced_[side] = buildReducedWishbone(scene, chassis, params_[side], *loops_[side], prefix);
+  addSpringMount(scene, side, prefix, springMount(chassis, reduced_[side].lower_arm, params_[side]),
+                 params_[side].stops);
 }
 
 double ReducedDoubleWishboneSuspension::getSuspensionCoordinate(const SimTK::State& s, int side) const {

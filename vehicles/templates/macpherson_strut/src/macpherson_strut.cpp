@@ -87,13 +87,14 @@ const FieldTable<MacPhersonStrutParams>& MacPhersonStrutParams::fields() {
           .number("camber_rad", &P::camber_rad, "rad", "static camber of the wheel, + top outward")
           .number("toe_in_rad", &P::toe_in_rad, "rad", "static toe of the wheel, + toe-in")
           .custom("spring", "-", "required",
-                  "stiffness_N_per_m, damping_N_s_per_m, free_length_m: the spring-damper along the strut, top mount "
-                  "to strut_upright",
+                  (std::string("stiffness_N_per_m, damping_N_s_per_m, free_length_m: the spring-damper along the strut, top mount "
+                               "to strut_upright") + SpringStopParams::fieldMeaning()).c_str(),
                   [](const ParamReader& r, P& p) {
                     const ParamReader s = r.child("spring");
                     p.spring_stiffness_N_per_m = s.number("stiffness_N_per_m");
                     p.damper_N_s_per_m = s.number("damping_N_s_per_m");
                     p.spring_free_length_m = s.number("free_length_m");
+                    p.stops = SpringStopParams::fromSpringBlock(s);
                   })
           .sample(R"({"stiffness_N_per_m": 29770, "damping_N_s_per_m": 2940, "free_length_m": 0.671})");
   return t;
@@ -182,6 +183,12 @@ void MacPhersonStrutSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody
   scene.addBody(prefix + "lower_arm", c.lower_arm);
   scene.addBody(prefix + "knuckle", c.upright);
   scene.addBody(prefix + "wheel", c.wheel);
+  SpringMount m;
+  m.a = chassis;
+  m.p_a = p.strut_chassis_m;
+  m.b = c.upright;
+  m.p_b = p.strut_upright_m - cu;
+  addSpringMount(scene, side, prefix, m, p.stops);
 }
 
 void registerMacPhersonStrut(PluginRegistry& registry) {

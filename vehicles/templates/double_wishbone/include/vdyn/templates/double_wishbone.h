@@ -41,6 +41,9 @@ class DoubleWishboneSuspension : public Suspension {
       : Suspension(std::move(name)), params_{right, right.mirrored()} {}
   void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) override;
   void DoShiftChassisFrame(const SimTK::Vec3& offset_m) override;
+  /// The spring's mounts of a built corner: the chassis point and the lower arm's.
+  static SpringMount springMount(const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& lowerArm,
+                                 const DoubleWishboneParams& p);
   DoubleWishboneParams params_[2];
 
  private:

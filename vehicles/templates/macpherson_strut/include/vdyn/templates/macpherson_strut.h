@@ -51,6 +51,7 @@ struct MacPhersonStrutParams {
   double spring_stiffness_N_per_m = 0;   ///< along the strut, top mount to strut_upright
   double damper_N_s_per_m = 0;
   double spring_free_length_m = 0;
+  SpringStopParams stops;                ///< bump and rebound stops along the strut (none by default)
 
   void validate(const std::string& where) const;
   static const FieldTable<MacPhersonStrutParams>& fields();
