@@ -673,3 +673,46 @@ TEST(VehicleReport, E90StaticLoadsAndMomentBalance) {
               r.corner_loads_N[0].second, r.corner_loads_N[1].second, r.corner_loads_N[2].second,
               r.corner_loads_N[3].second, r.front_axle_load_N, r.front_axle_load_from_moments_N, r.weight_N);
 }
+
+// The BMW E90 (bmw_e90.json: MacPherson front, double wishbone rear on its tie
+// rods, anti-roll bars, the design ride height) on ISO 4138 at R = 100 m, as
+// scenes/iso4138_e90.json composes it: every steady state on the radius
+// (path radius 100 m; a_y = U^2 / R to 1e-3: the speed hold (3.18) holds the
+// speed in the chassis plane, which the roll and side slip make differ from
+// the horizontal speed by less than that), stable, up to a fold in speed;
+// the anti-roll bars lower the roll at equal lateral acceleration (the same
+// car without them, the bars' share of the roll stiffness).
+TEST(Iso4138, E90ReachesItsLimitOnTheRadiusAndItsBarsReduceRoll) {
+  PluginRegistry& reg = standardRegistry();
+  auto run = [&](bool bars) {
+    SceneDescription d = SceneDescription::fromFile("scenes/iso4138_e90.json", reg);
+    if (!bars)
+      d = d.withOverrides({{"vehicle.overrides.axles.front.anti_roll_bar", Json(nullptr)},
+                           {"vehicle.overrides.axles.rear.anti_roll_bar", Json(nullptr)}});
+    auto h = buildHandlingScene(d, HandlingSetup{});
+    ConstantRadiusSettings set;
+    set.radius_m = 100;
+    set.speed_start_m_s = 10;
+    set.speed_step_m_s = 2;
+    set.speed_max_m_s = 60;
+    set.stability = bars;
+    return runConstantRadius(h->vehicle, set);
+  };
+  const ConstantRadiusResult r = run(true);
+  ASSERT_TRUE(r.limit_found) << r.limit_reason;
+  ASSERT_GE(r.points.size(), 6u);
+  for (const auto& q : r.points) {
+    EXPECT_NEAR(q.path_radius_m, 100.0, 1e-8) << q.speed_m_s;
+    const double ay = q.speed_m_s * q.speed_m_s / 100.0;
+    EXPECT_NEAR(q.lateral_accel_m_s2, ay, 1e-3 * ay) << q.speed_m_s;
+    if (q.speed_m_s < r.limit_speed_m_s - 1) EXPECT_TRUE(q.stable) << q.speed_m_s;
+  }
+  EXPECT_GT(r.limit_lateral_accel_m_s2, 6.0);
+  const ConstantRadiusResult n = run(false);
+  ASSERT_GE(n.points.size(), 3u);
+  EXPECT_NEAR(n.points[1].speed_m_s, r.points[1].speed_m_s, 1e-12);
+  EXPECT_LT(std::abs(r.points[1].roll_rad), 0.8 * std::abs(n.points[1].roll_rad));
+  std::printf("e90 R 100 m: limit %.3f m/s, a_y %.3f m/s^2; roll at %.0f m/s %.3f deg with bars, %.3f deg without\n",
+              r.limit_speed_m_s, r.limit_lateral_accel_m_s2, r.points[1].speed_m_s, r.points[1].roll_rad / kDeg,
+              n.points[1].roll_rad / kDeg);
+}
