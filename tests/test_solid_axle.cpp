@@ -234,6 +234,31 @@ TEST(SolidAxle, DegreesOfFreedomMassAndTheSharedHousing) {
   EXPECT_LT(rig.susp.calcLoopGap(s, 0), 1e-15);
 }
 
+TEST(SolidAxle, ShiftingTheChassisFrameMovesEveryPoint) {
+  // Data in a frame whose origin is d behind the c.m. frame: shifted by -d,
+  // every chassis-frame point is the original one (the vehicle's chassis com_m).
+  const SolidAxleParams p = fourLink();
+  const Vec3 d(0.3, -0.02, 0.1);
+  SolidAxleParams q = p;
+  q.axle_com_m += d;
+  for (int side = 0; side < 2; ++side) q.spindle_m[side] += d, q.spring_chassis_m[side] += d, q.spring_axle_m[side] += d;
+  for (SolidAxleLink& l : q.links) l.chassis_m += d, l.axle_m += d;
+  SolidAxleSuspension susp(q);
+  susp.shiftChassisFrame(-d);
+  const SolidAxleParams& r = susp.getParams();
+  double worst = (r.axle_com_m - p.axle_com_m).norm();
+  for (int side = 0; side < 2; ++side) {
+    worst = std::max(worst, (susp.calcWheelCentreInChassis(side) - p.spindle_m[side]).norm());
+    worst = std::max(worst, (r.spring_chassis_m[side] - p.spring_chassis_m[side]).norm());
+    worst = std::max(worst, (r.spring_axle_m[side] - p.spring_axle_m[side]).norm());
+  }
+  for (std::size_t i = 0; i < p.links.size(); ++i) {
+    worst = std::max(worst, (r.links[i].chassis_m - p.links[i].chassis_m).norm());
+    worst = std::max(worst, (r.links[i].axle_m - p.links[i].axle_m).norm());
+  }
+  EXPECT_LT(worst, 1e-15);
+}
+
 TEST(SolidAxle, FourLinkMirrorsAndThePanhardRodShiftsTheAxle) {
   // The four-link is symmetric: travels (a, b) give the right wheel what
   // (b, a) gives the left, and the opposite roll.
