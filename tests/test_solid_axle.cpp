@@ -125,6 +125,10 @@ Worst compareWithReference(const SolidAxleParams& p, const char* name) {
   SimTK::State s = rig.scene.getDefaultState();
   rig.scene.getSystem().realize(s, SimTK::Stage::Position);
   EXPECT_LT(rig.susp.calcLoopGap(s, 0), 1e-15);  // the design lengths are the data's
+  // The wheels turned on their spin pins: the spin axis read from the wheel
+  // body is the pin's own axis only if the pin turns about it.
+  rig.susp.getCorner(0).wheel.setOneQ(s, 0, 1.0);
+  rig.susp.getCorner(1).wheel.setOneQ(s, 0, -2.0);
   const kr::SolidAxleHardpoints hp = referenceHardpoints(p);
   for (double z = -0.02; z >= -0.081; z -= 0.02) rig.setTravels(s, z, z);  // to the grid's first corner
   Worst w;
@@ -144,7 +148,7 @@ Worst compareWithReference(const SolidAxleParams& p, const char* name) {
         const double yOut = side == 0 ? -1 : 1;
         w.travel = std::max(w.travel, std::abs(rig.susp.getSuspensionCoordinate(s, side) - (side == 0 ? zr : zl)));
         centre[side] = c.wheel.getBodyOriginLocation(s);
-        const Vec3 spinLeft = c.knuckle.getBodyRotation(s) * rig.susp.getSpinAxis(side).asVec3();
+        const Vec3 spinLeft = c.wheel.getBodyRotation(s) * rig.susp.getSpinAxis(side).asVec3();
         const Vec3 out = yOut * spinLeft;
         for (int m = 0; m < 3; ++m) {
           w.centre = std::max(w.centre, std::abs(centre[side][m] - k.wheel_centre_m[m]));
