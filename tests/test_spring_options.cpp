@@ -186,3 +186,27 @@ TEST(SpringStops, BadDataIsNamed) {
   const std::string e2 = errorOf([&] { WheeledVehicle car(q); });
   EXPECT_NE(e2.find("rebound_stop.stiffness_N_per_m: missing"), std::string::npos) << e2;
 }
+
+// The option on a dependent axle (App. A with the solid rear axle of
+// appendix_a_solid_rear.json): both rear springs at their design length at
+// rest, the tires carrying the weight; a bump stop on its spring line reports
+// k (L - l) of that line.
+TEST(RideHeight, SolidAxleRear) {
+  WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a_solid_rear.json");
+  WheeledVehicleParams::RideHeightReport rep;
+  const WheeledVehicleParams q = p.withRideHeightSprings(vehiclePlugins(), &rep);
+  const Rest r = restOf(q);
+  for (int c = 0; c < 4; ++c) EXPECT_NEAR(r.spring_length_m[c], r.design_length_m[c], 2e-9) << "corner " << c;
+  double sum = 0;
+  for (double f : r.fz_N) sum += f;
+  EXPECT_NEAR(sum, r.weight_N, 1e-9 * r.weight_N);
+  std::printf("solid rear ride height: %d equilibria, rear free length %.6f m (data %.6f)\n", rep.iterations,
+              rep.free_length_m[2], p.axles[1].suspension.block["spring"]["free_length_m"].get<double>());
+  WheeledVehicleParams s = q;
+  const double lb = r.spring_length_m[2] + 0.003, kb = 1e5;
+  s.updAxle("rear").suspension.block["spring"]["bump_stop"] = {{"length_m", lb}, {"stiffness_N_per_m", kb}};
+  const Rest b = restOf(s, {"rr.spring_length_m", "rr.bump_stop_N", "lr.bump_stop_N"});
+  EXPECT_NEAR(b.outputs.at("rr.bump_stop_N"), kb * (lb - b.outputs.at("rr.spring_length_m")), 1e-6);
+  EXPECT_GT(b.outputs.at("rr.bump_stop_N"), 10.0);
+  EXPECT_GT(b.outputs.at("lr.bump_stop_N"), 10.0);
+}

@@ -5,6 +5,7 @@
 
 #include "vdyn/templates/double_wishbone.h"
 #include "vdyn/templates/macpherson_strut.h"
+#include "vdyn/templates/solid_axle.h"
 
 #include "vdyn/plugins/builtin.h"
 #include "vdyn/vehicles/anti_roll_bar.h"
@@ -165,6 +166,7 @@ std::unique_ptr<Suspension> makeSuspension(const PluginRegistry& registry, const
 void registerSuspensionTemplates(PluginRegistry& registry) {
   registerDoubleWishboneTemplates(registry);
   registerMacPhersonStrut(registry);
+  registerSolidAxle(registry);
 }
 
 const PluginRegistry& vehiclePlugins() {
