@@ -119,19 +119,17 @@ Outcome runCell(const Cell& c, double tEnd, double budget) {
     const SceneDescription base = SceneDescription::fromFile(sceneFile(c.vehicle), standardRegistry());
     const SceneDescription desc = base.withOverrides(overridesOf(c, tEnd, budget, base.json()));
     BuiltScene built = desc.build();
-    const TransientSettings ts =
+    TransientSettings ts =
         TransientSettings::fields().read(ParamReader::fromJson(desc.json().at("analysis"), desc.path() + " analysis"));
     const Scene& scene = built.scene();
-    EventLimits lim;
-    lim.stop_on_spin_out = lim.stop_on_rollover = true;
-    EventMonitor events(scene, lim);
+    ts.events.stop_on_spin_out = ts.events.stop_on_rollover = true;
     TransientRun tr;
     bool finished = false;
     try {
-      tr = runTransient(built, ts, [&](const std::string&, double) { return events.callback(); });
+      tr = runTransient(built, ts, {});
       finished = true;
-      o.status = events.events().empty() ? "completed" : "event:" + events.events().front().kind;
-      if (!events.events().empty()) o.detail = events.events().front().describe();
+      o.status = tr.events.empty() ? "completed" : "event:" + tr.events.front().kind;
+      if (!tr.events.empty()) o.detail = tr.events.front().describe();
     } catch (const RunStopped& e) {
       o.status = "event:" + e.event.kind;
       o.detail = e.event.describe();

@@ -633,3 +633,44 @@ TEST(SceneAnalyses, SteadyStateStartIsStraightOrGiven) {
   EXPECT_GT(straight["homotopy_steps"].get<int>(), 0);
   EXPECT_FALSE(given.contains("homotopy_steps"));
 }
+
+// A transient that leaves its regime (the ch3 turn at 15 m/s spins) is a
+// result: its summary lists the spin-out with the time and value it was first
+// seen (beyond the stated 0.35 rad, no larger than the run's peak side slip),
+// and the run ends normally; listed in analysis.events.fatal it ends the run
+// with the event's line naming the option; the 10 m/s turn has no event.
+TEST(SceneFile, TransientRecordsItsRegimeEventsAndAFatalOneEndsTheRun) {
+  PluginRegistry& reg = standardRegistry();
+  const SceneDescription base = SceneDescription::fromFile("scenes/ch3_transient.json", reg);
+  const SceneDescription fast = base.withOverrides({{"vehicle.initial_speed_m_s", 15.0},
+                                                    {"plugins.speed_hold.speed_m_s", 15.0},
+                                                    {"analysis.t_end_s", 14.0}});
+  RunOptions opt;  // no files
+  opt.plots = false;
+  const Json s = runScene(fast, opt);
+  ASSERT_EQ(s.at("events").size(), 1u) << s.at("events").dump();
+  const Json& e = s.at("events")[0];
+  EXPECT_EQ(e.at("kind"), "spin_out");
+  EXPECT_EQ(e.at("object"), "chassis.side_slip_rad");
+  EXPECT_GT(e.at("time_s").get<double>(), 1.5);
+  EXPECT_LT(e.at("time_s").get<double>(), 14.0);
+  EXPECT_GT(std::abs(e.at("value").get<double>()), 0.35);
+  EXPECT_LE(std::abs(e.at("value").get<double>()), s.at("peak_abs").at("chassis.side_slip_rad").get<double>() + 1e-12);
+  EXPECT_NE(e.at("message").get<std::string>().find("spin_out at t = "), std::string::npos);
+  std::printf("15 m/s: %s\n", e.at("message").get<std::string>().c_str());
+
+  const std::string fatal = errorOf([&] {
+    runScene(fast.withOverride("analysis.events.fatal", Json::array({"spin_out"})), opt);
+  });
+  EXPECT_NE(fatal.find("spin_out at t = "), std::string::npos) << fatal;
+  EXPECT_NE(fatal.find("analysis.events.fatal"), std::string::npos) << fatal;
+  const std::string unknown = errorOf([&] {
+    runScene(fast.withOverride("analysis.events.fatal", Json::array({"spin"})), opt);
+  });
+  EXPECT_NE(unknown.find("unknown event kind 'spin' (known: spin_out, rollover, left_path, lift_off)"),
+            std::string::npos)
+      << unknown;
+
+  const Json slow = runScene(base.withOverride("analysis.t_end_s", 3.0), opt);
+  EXPECT_TRUE(slow.at("events").empty());
+}

@@ -16,6 +16,61 @@ void EventLimits::validate() const {
   requirePositive(left_path_distance_m, "event limit left_path_distance_m");
 }
 
+EventLimits EventLimits::recordOnly() {
+  EventLimits l;
+  l.stop_on_spin_out = l.stop_on_rollover = l.stop_on_left_path = l.stop_on_lift_off = false;
+  return l;
+}
+
+const FieldTable<EventLimits>& EventLimits::fields() {
+  using E = EventLimits;
+  static const auto t =
+      FieldTable<E>()
+          .number("spin_out_side_slip_rad", &E::spin_out_side_slip_rad, "rad",
+                  "spin_out when |chassis.side_slip_rad| exceeds this")
+          .number("spin_out_min_speed_m_s", &E::spin_out_min_speed_m_s, "m/s",
+                  "side slip is checked only while |chassis.forward_speed_m_s| is at least this")
+          .number("rollover_roll_rad", &E::rollover_roll_rad, "rad", "rollover when |chassis.roll_rad| exceeds this")
+          .number("lift_off_load_N", &E::lift_off_load_N, "N",
+                  "lift_off when a tire's normal load (<tire>.Fz_N) is at most this")
+          .number("left_path_distance_m", &E::left_path_distance_m, "m",
+                  "left_path when |<controller>.path_distance_m| exceeds this")
+          .number("start_time_s", &E::start_time_s, "s", "no event is checked before this time (a settling phase)")
+          .custom("fatal", "-", "[] (transient analysis)",
+                  "the event kinds that end the run with an error (spin_out, rollover, left_path, lift_off); the "
+                  "others are recorded in summary.json \"events\" with their time and value",
+                  [](const ParamReader& r, E& e) {
+                    if (!r.has("fatal")) return;
+                    const Json& a = r.raw("fatal");
+                    if (!a.is_array()) throw Error(r.at("fatal") + ": expected a list of event kinds, got " + a.dump());
+                    e.stop_on_spin_out = e.stop_on_rollover = e.stop_on_left_path = e.stop_on_lift_off = false;
+                    for (const Json& k : a) {
+                      const std::string kind = k.is_string() ? k.get<std::string>() : k.dump();
+                      if (kind == "spin_out") e.stop_on_spin_out = true;
+                      else if (kind == "rollover") e.stop_on_rollover = true;
+                      else if (kind == "left_path") e.stop_on_left_path = true;
+                      else if (kind == "lift_off") e.stop_on_lift_off = true;
+                      else
+                        throw Error(r.at("fatal") + ": unknown event kind '" + kind +
+                                    "' (known: spin_out, rollover, left_path, lift_off)");
+                    }
+                  })
+          .sample(R"(["spin_out"])");
+  return t;
+}
+
+Json eventsToJson(const std::vector<Event>& events) {
+  Json a = Json::array();
+  for (const auto& e : events)
+    a.push_back({{"kind", e.kind},
+                 {"object", e.object},
+                 {"time_s", e.time_s},
+                 {"value", e.value},
+                 {"limit", e.limit},
+                 {"message", e.describe()}});
+  return a;
+}
+
 std::string Event::describe() const {
   char buf[256];
   if (kind == "lift_off")
@@ -56,7 +111,7 @@ void EventMonitor::check(const SimTK::State& s) {
   if (t < limits_.start_time_s) return;
   auto fire = [&](const std::string& kind, const std::string& object, double value, double limit, bool stop) {
     events_.push_back({kind, object, t, value, limit});
-    if (stop) throw RunStopped(events_.back(), stateSummary(scene_, s));
+    if (stop) throw RunStopped(events_.back(), stateSummary(scene_, s), events_);
   };
   // Side slip means nothing near standstill (atan2 of two tiny velocities).
   const bool moving = !speed_ || std::abs(scene_.evalOutput("chassis.forward_speed_m_s", s)) >=
@@ -74,7 +129,7 @@ void EventMonitor::check(const SimTK::State& s) {
   for (const auto& n : loads_) {
     if (seen("lift_off", n)) continue;
     const double fz = scene_.evalOutput(n, s);
-    if (fz <= limits_.lift_off_load_N) fire("lift_off", n, fz, limits_.lift_off_load_N, false);
+    if (fz <= limits_.lift_off_load_N) fire("lift_off", n, fz, limits_.lift_off_load_N, limits_.stop_on_lift_off);
   }
   for (const auto& n : paths_) {
     if (seen("left_path", n)) continue;
@@ -91,11 +146,5 @@ std::function<void(const SimTK::State&)> EventMonitor::callback(std::function<vo
   };
 }
 
-Json EventMonitor::toJson() const {
-  Json a = Json::array();
-  for (const auto& e : events_)
-    a.push_back({{"kind", e.kind}, {"object", e.object}, {"time_s", e.time_s}, {"value", e.value}, {"limit", e.limit}});
-  return a;
-}
 
 }  // namespace vdyn

@@ -34,25 +34,27 @@ int main(int argc, char** argv) {
     // Physical events (spin-out and rollover end the run) and, at the end, the
     // steady verdict: the final values are the steady turn's only if the run
     // ended steady; otherwise no radius is reported and the study exits 1.
-    EventMonitor events(built.scene());
+    // The study's claim is a steady turn: a spin-out or a rollover ends its run.
+    TransientSettings settings = ch3.transient;
+    settings.events.stop_on_spin_out = settings.events.stop_on_rollover = true;
     TransientRun tr;
     try {
-      tr = runTransient(built, ch3.transient, [&](const std::string& label, double tEnd) {
-        return events.callback(study::progress(label, tEnd));
+      tr = runTransient(built, settings, [&](const std::string& label, double tEnd) {
+        return study::progress(label, tEnd);
       });
     } catch (const RunStopped& e) {
       study::endProgress();
       study::writeJson(out + "/summary.json", {{"completed", false},
                                                {"steady", false},
                                                {"reason", e.what()},
-                                               {"events", events.toJson()},
+                                               {"events", eventsToJson(e.events)},
                                                {"speed_m_s", U0},
                                                {"front_rad", front},
                                                {"rear_rad", rear},
                                                {"event_limits",
-                                                {{"spin_out_side_slip_rad", events.limits().spin_out_side_slip_rad},
-                                                 {"rollover_roll_rad", events.limits().rollover_roll_rad}}}});
-      for (const auto& ev : events.events()) std::printf("ch3_transient: event: %s\n", ev.describe().c_str());
+                                                {{"spin_out_side_slip_rad", settings.events.spin_out_side_slip_rad},
+                                                 {"rollover_roll_rad", settings.events.rollover_roll_rad}}}});
+      for (const auto& ev : e.events) std::printf("ch3_transient: event: %s\n", ev.describe().c_str());
       throw Error(std::string("the vehicle left its regime: ") + e.what() + " (no steady values reported)");
     }
     study::endProgress();
@@ -93,7 +95,7 @@ int main(int argc, char** argv) {
                                       {"relative_tolerance", steadyRel},
                                       {"absolute_tolerance", steadyAbs},
                                       {"verdict", verdict.toJson()}}},
-                    {"events", events.toJson()},
+                    {"events", eventsToJson(tr.events)},
                     {"yaw_rate_rad_s", r},
                     {"roll_rate_rad_s", fin("chassis.roll_rate_rad_s")},
                     {"pitch_rate_rad_s", fin("chassis.pitch_rate_rad_s")},
@@ -137,7 +139,7 @@ int main(int argc, char** argv) {
       std::printf("  yaw rate            %.6f rad/s (path radius %.3f m), steady\n", r, U0 / r);
     else
       std::printf("  yaw rate at the end %.6f rad/s: NOT steady (%s)\n", r, verdict.reason.c_str());
-    for (const auto& e : events.events()) std::printf("  event: %s\n", e.describe().c_str());
+    for (const auto& e : tr.events) std::printf("  event: %s\n", e.describe().c_str());
     std::printf("  roll / pitch        %.6f / %.6f rad (rates %.2e / %.2e rad/s)\n", fin("chassis.roll_rad"),
                 fin("chassis.pitch_rad"), fin("chassis.roll_rate_rad_s"), fin("chassis.pitch_rate_rad_s"));
     std::printf("  chassis height      %.6f m; side slip %.6f rad; speed-hold force %.2f N\n", fin("chassis.z_m"),

@@ -32,14 +32,14 @@ RunResult runOne(const SceneDescription& base, const ParamReader& m, const std::
   const SceneDescription scene = base.withOverrides({{"plugins.path_control.path", m.child("path").json()},
                                                      {"plugins.path_control.gains", m.child("gains").json()},
                                                      {"analysis.t_end_s", m.number("t_end_s")}});
-  const TransientSettings settings = TransientSettings::fields().read(
+  TransientSettings settings = TransientSettings::fields().read(
       ParamReader::fromJson(scene.json().at("analysis"), scene.path() + " analysis"));
   BuiltScene built = scene.build();
   // Leaving the path (|path distance| beyond 2 m), a spin-out or a rollover
   // stops the run with the event and its time (core/events.h).
-  EventMonitor events(built.scene());
+  settings.events.stop_on_spin_out = settings.events.stop_on_rollover = settings.events.stop_on_left_path = true;
   const TransientRun tr = runTransient(built, settings, [&](const std::string&, double tEnd) {
-    return events.callback(study::progress(name, tEnd));
+    return study::progress(name, tEnd);
   });
   study::endProgress();
   const Recorder& rec = *tr.recorder;
@@ -52,7 +52,7 @@ RunResult runOne(const SceneDescription& base, const ParamReader& m, const std::
   study::writePathCsv(r.path_csv, *path, 10.0, 20.0);
   const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
   r.summary = {{"name", name},
-               {"events", events.toJson()},
+               {"events", eventsToJson(tr.events)},
                {"path", m.child("path").json()},
                {"gains", m.child("gains").json()},
                {"max_path_error_m", err.max_abs},

@@ -43,6 +43,9 @@ int runCommand(const std::vector<std::string>& args) {
               summary.value("analysis", std::string("?")).c_str(), options.out_dir.c_str());
   for (auto it = summary.begin(); it != summary.end(); ++it)
     if (it.value().is_number()) std::printf("  %-32s %.10g\n", it.key().c_str(), it.value().get<double>());
+  // Regime events (a spin-out, a lift-off): a result of the run, never silent.
+  if (summary.contains("events") && summary["events"].is_array())
+    for (const Json& e : summary["events"]) std::printf("  event: %s\n", e.value("message", e.dump()).c_str());
   return 0;
 }
 

@@ -20,7 +20,10 @@ const FieldTable<TransientSettings>& TransientSettings::fields() {
                    "outputs y whose int y^2 dt is integrated with error control (cost, seed 4.46)")
           .boolean("write_history", &TransientSettings::write_history, "write history.csv of the recorded outputs")
           .number("wall_time_budget_s", &TransientSettings::wall_time_budget_s, "s",
-                  "wall-clock budget of the run (0 = none): beyond it the run stops with a named error");
+                  "wall-clock budget of the run (0 = none): beyond it the run stops with a named error")
+          .object("events", &TransientSettings::events, EventLimits::fields(),
+                  "regime guards: spin_out, rollover, lift_off, left_path are recorded in summary.json \"events\" "
+                  "with their time and value; those in \"fatal\" end the run with an error");
   return t;
 }
 
@@ -47,7 +50,9 @@ TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, 
   if (!built.outputs.empty()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
   const SimulationSettings sim = settings.simulation();
   ProgressCallback cb = progress ? progress(built.name, sim.t_end_s) : ProgressCallback{};
-  r.run = simulate(scene, r.final_state, sim, r.recorder.get(), cb);
+  EventMonitor events(scene, settings.events);
+  r.run = simulate(scene, r.final_state, sim, r.recorder.get(), events.callback(cb));
+  r.events = events.events();
   for (const auto& h : handles) r.integrals.push_back(scene.getIntegral(h, r.final_state));
   return r;
 }
@@ -91,6 +96,7 @@ Json summarizeTransient(const BuiltScene& built, const TransientSettings& settin
             {"wall_time_s", run.wall_time_s},
             {"real_time_factor", run.sim_time_s / run.wall_time_s},
             {"warnings", run.warnings}}},
+          {"events", eventsToJson(r.events)},
           {"vehicle", r.vehicle}};
 }
 
@@ -128,7 +134,12 @@ class TransientAnalysis : public Analysis {
 
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
-    const TransientRun run = runTransient(ctx.built, s_, ctx.progress);
+    TransientRun run;
+    try {
+      run = runTransient(ctx.built, s_, ctx.progress);
+    } catch (const RunStopped& e) {
+      throw Error(std::string(e.what()) + " (an event kind listed in analysis.events.fatal)");
+    }
     AnalysisResult res;
     res.summary = summarizeTransient(ctx.built, s_, run);
     if (run.recorder && s_.write_history) res.tables.push_back({"history", historyTable(*run.recorder)});

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "vdyn/core/error.h"
+#include "vdyn/core/fields.h"
 #include "vdyn/core/params.h"
 #include "vdyn/core/scene.h"
 
@@ -30,11 +31,19 @@ struct EventLimits {
   /// Left the path when |"<controller>.path_distance_m"| exceeds this, m
   /// (2 m: the seed's chapter 8 abort limit, half a lane and more).
   double left_path_distance_m = 2.0;
-  /// Spin-out, rollover and leaving the path end the run (RunStopped) unless false.
-  bool stop_on_spin_out = true, stop_on_rollover = true, stop_on_left_path = true;
+  /// Spin-out, rollover and leaving the path end the run (RunStopped) unless
+  /// false; a lift-off only when stop_on_lift_off is true.
+  bool stop_on_spin_out = true, stop_on_rollover = true, stop_on_left_path = true, stop_on_lift_off = false;
   /// Checks start at this time, s (lift-off during a settling phase is not an event).
   double start_time_s = 0.0;
   void validate() const;
+  /// The limits with no event fatal (a transient analysis' default: a spin is
+  /// a result, recorded with its time, not a failure).
+  static EventLimits recordOnly();
+  /// The data keys (a scene's "analysis": {"events": {...}}): the limits, and
+  /// "fatal": the kinds that end the run ([] = none; spin_out, rollover,
+  /// left_path, lift_off); absent keys keep the struct's values.
+  static const FieldTable<EventLimits>& fields();
 };
 
 struct Event {
@@ -50,9 +59,14 @@ struct Event {
 /// Thrown from the step callback when a stopping event happens.
 class RunStopped : public Error {
  public:
-  RunStopped(const Event& e, const std::string& where) : Error(e.describe() + "; run stopped at " + where), event(e) {}
+  RunStopped(const Event& e, const std::string& where, std::vector<Event> all = {})
+      : Error(e.describe() + "; run stopped at " + where), event(e), events(std::move(all)) {}
   Event event;
+  std::vector<Event> events;  ///< every event of the run up to this one (this one last)
 };
+
+/// [{"kind", "object", "time_s", "value", "limit", "message" (Event::describe)}...]
+Json eventsToJson(const std::vector<Event>& events);
 
 class EventMonitor {
  public:
@@ -65,8 +79,8 @@ class EventMonitor {
   std::function<void(const SimTK::State&)> callback(std::function<void(const SimTK::State&)> next = {});
   const std::vector<Event>& events() const { return events_; }
   bool has(const std::string& kind) const;
-  /// [{"kind", "object", "time_s", "value", "limit"}...]
-  Json toJson() const;
+  /// [{"kind", "object", "time_s", "value", "limit", "message"}...]
+  Json toJson() const { return eventsToJson(events_); }
   const EventLimits& limits() const { return limits_; }
 
  private:

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "vdyn/core/analysis.h"
+#include "vdyn/core/events.h"
 #include "vdyn/core/fields.h"
 #include "vdyn/core/recorder.h"
 #include "vdyn/core/registry.h"
@@ -34,6 +35,10 @@ struct TransientSettings {
   /// Wall-clock budget of the run, s (0 = none): beyond it simulate() stops
   /// with a named error saying where (SimulationSettings::wall_time_budget_s).
   double wall_time_budget_s = 0;
+  /// Regime guards ("events": {...}, core/events.h): spin-out, rollover,
+  /// lift-off and leaving the path are recorded with their time and value in
+  /// the summary's "events"; none ends the run unless "fatal" lists it.
+  EventLimits events = EventLimits::recordOnly();
 
   static const FieldTable<TransientSettings>& fields();
   SimulationSettings simulation() const;
@@ -46,6 +51,7 @@ struct TransientRun {
   std::unique_ptr<Recorder> recorder;      ///< the scene's "outputs" sampled every report interval
   std::vector<double> integrals;           ///< one per TransientSettings::integrals_of_square
   Json vehicle;                            ///< Vehicle::describe at the initial state
+  std::vector<Event> events;               ///< the regime events of the run (TransientSettings::events)
 };
 
 /// Runs the built scene from its initial state to settings.t_end_s, recording
