@@ -179,10 +179,11 @@ TEST(FourWsSteering, OppositeStepsGiveMirroredYawRates) {
 TEST(FourWsSteering, CommandErrorsAreNamed) {
   const auto cmd = [](const Json& j) { return makeSteeringCommand(ParamReader::fromJson(j, "scene.json steering")); };
   try {
-    cmd(Json{{"type", "ramp"}});
+    cmd(Json{{"type", "zigzag"}});
     FAIL() << "no error";
   } catch (const Error& e) {
-    EXPECT_STREQ(e.what(), "scene.json steering: type: unknown steering command 'ramp'; known: hold, smooth_step, steps");
+    EXPECT_STREQ(e.what(), "scene.json steering: type: unknown steering command 'zigzag'; known: chirp, hold, ramp, "
+                           "sine, sine_with_dwell, smooth_step, steps, table");
   }
   try {
     cmd(Json{{"type", "smooth_step"}, {"final_rad", 0.1}, {"start_time_s", 0.5}, {"duration_s", -1.0}});

@@ -383,7 +383,8 @@ TEST(Registry, ChoicesAreRegisteredNamesThatPluginsOfASceneFind) {
   // Not in the standard registry: the same scene names an unknown command.
   const std::string unknown = errorOf([&] { SceneDescription::fromJson(j, "small.json", standardRegistry()).build(); });
   EXPECT_TRUE(contains(unknown, "small.json") &&
-              contains(unknown, "unknown steering command 'fixture_const'; known: hold, smooth_step, steps"))
+              contains(unknown, "unknown steering command 'fixture_const'; known: chirp, hold, ramp, sine, sine_with_dwell, "
+                                "smooth_step, steps, table"))
       << unknown;
   EXPECT_EQ(r.choiceFamilies(),
             (std::vector<std::string>{"anti_roll_bar_template", "rear_steer_strategy", "sensitivity_method",

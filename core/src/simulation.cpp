@@ -1,3 +1,4 @@
+#include <algorithm>
 #include "vdyn/core/simulation.h"
 #include "vdyn/core/interrupt.h"
 
@@ -84,9 +85,23 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   }
   const auto wall0 = std::chrono::steady_clock::now();
 
+  // Segments: the integrator stops at each restart time (an input whose rate
+  // jumps there) and starts afresh from the right, its initialisation
+  // projecting the velocities onto the new rate; no error-controlled step
+  // passes a velocity-level step.
+  std::vector<double> ends;
+  for (double r : s.restart_times_s)
+    if (r > t0 && r < s.t_end_s) ends.push_back(r);
+  std::sort(ends.begin(), ends.end());
+  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
+  ends.push_back(s.t_end_s);
+  std::size_t seg = 0;
+  double segEnd = ends[0];
+  long doneSteps = 0, doneAttempts = 0, doneRealizations = 0, doneProjections = 0;  // of finished segments
+
   auto integ = makeIntegrator(scene.getSystem(), s.integrator);
   integ->setReturnEveryInternalStep(true);
-  integ->setFinalTime(s.t_end_s);
+  integ->setFinalTime(segEnd);
   try {
     integ->initialize(state);
   } catch (const std::exception& e) {
@@ -162,7 +177,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   for (;;) {
     SimTK::Integrator::SuccessfulStepStatus status;
     try {
-      status = integ->stepTo(reporting && !ownInterpolation ? nextReport() : s.t_end_s);
+      status = integ->stepTo(reporting && !ownInterpolation ? std::min(nextReport(), segEnd) : segEnd);
     } catch (const std::exception& e) {
       throw Error("simulate: " + s.integrator.method + " failed at t = " +
                   formatValue(integ->getTime()) + " s: " + e.what());
@@ -176,7 +191,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       const SimTK::State& adv = integ->getAdvancedState();
       sum.max_constraint_error = std::max(sum.max_constraint_error, positionConstraintError(adv));
       if (afterStep) afterStep(adv);
-      if (s.max_steps > 0 && integ->getNumStepsAttempted() >= s.max_steps)
+      if (s.max_steps > 0 && doneAttempts + integ->getNumStepsAttempted() >= s.max_steps)
         throw stopped("step limit max_steps = " + std::to_string(s.max_steps) + " reached");
       const double h = integ->getPreviousStepSizeTaken();
       smallSteps = (s.min_step_s > 0 && h < s.min_step_s && adv.getTime() < s.t_end_s - tEndTol) ? smallSteps + 1 : 0;
@@ -200,6 +215,30 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         ++k;
       }
     }
+    const double segTol = 1e-12 * std::max(1.0, std::abs(segEnd));
+    if (seg + 1 < ends.size() && (status == S::EndOfSimulation || integ->getTime() >= segEnd - segTol)) {
+      // A restart: the next segment starts at the restart time itself (its input from the right).
+      doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
+      doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+      SimTK::State st = integ->getState();
+      st.setTime(segEnd);
+      segEnd = ends[++seg];
+      integ->setFinalTime(segEnd);
+      try {
+        integ->initialize(st);
+      } catch (const std::exception& e) {
+        throw Error("simulate: restarting " + s.integrator.method + " at t = " + formatValue(st.getTime()) +
+                    " s (an input's rate jumps there) failed: " + e.what());
+      }
+      if (ownInterpolation) {
+        const SimTK::State& s1 = integ->getState();
+        scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
+        yPrev = s1.getY();
+        ydotPrev = s1.getYDot();
+        tPrev = s1.getTime();
+      }
+      continue;
+    }
     if (status == S::EndOfSimulation || integ->getTime() >= s.t_end_s - tEndTol) {
       if (reporting && integ->getTime() > lastReported + tEndTol) recorder->record(integ->getState());
       break;
@@ -212,10 +251,10 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
                 SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");
 
   state = integ->getState();
-  sum.steps = integ->getNumStepsTaken();
-  sum.attempts = integ->getNumStepsAttempted();
-  sum.realizations = integ->getNumRealizations() + ownRealizations;
-  sum.projections = integ->getNumProjections();
+  sum.steps = int(doneSteps + integ->getNumStepsTaken());
+  sum.attempts = int(doneAttempts + integ->getNumStepsAttempted());
+  sum.realizations = int(doneRealizations + integ->getNumRealizations() + ownRealizations);
+  sum.projections = int(doneProjections + integ->getNumProjections());
   sum.sim_time_s = s.t_end_s - t0;
   sum.wall_time_s =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();

@@ -48,7 +48,9 @@ TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, 
   for (const auto& p : built.scene().getPlugins()) p->checkInitialState(built.scene(), r.final_state);
   r.vehicle = built.vehicle->describe(r.final_state);
   if (!built.outputs.empty()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
-  const SimulationSettings sim = settings.simulation();
+  SimulationSettings sim = settings.simulation();
+  for (const auto& p : scene.getPlugins())
+    for (double t : p->calcInputJumpTimes()) sim.restart_times_s.push_back(t);
   ProgressCallback cb = progress ? progress(built.name, sim.t_end_s) : ProgressCallback{};
   EventMonitor events(scene, settings.events);
   r.run = simulate(scene, r.final_state, sim, r.recorder.get(), events.callback(cb));

@@ -1,5 +1,6 @@
 #include "vdyn/core/text.h"
 #include "vdyn/steering/steering.h"
+#include "vdyn/steering/commands.h"
 
 #include <sstream>
 
@@ -134,6 +135,7 @@ void registerSteeringCommands(PluginRegistry& registry) {
         return std::make_unique<StepSequenceCommand>(k.initial_rad, std::move(k.steps));
       },
       typeInfo("smooth steps (7.4) added together (Figure 7.2's open-loop inputs)", stepsFields()));
+  registerWaveformCommands(registry);
 }
 
 namespace {

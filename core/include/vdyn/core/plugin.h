@@ -56,6 +56,11 @@ class Plugin {
   /// plugin and listing its adjustables if `key` is not one of them.
   void setAdjustable(SimTK::State& state, const std::string& key, double value) const;
 
+  /// Times (s, absolute) where an input the plugin prescribes is only C0 (a
+  /// steering command whose rate jumps): a transient restarts its integrator
+  /// there (SimulationSettings::restart_times_s). Empty by default.
+  std::vector<double> calcInputJumpTimes() const { return DoCalcInputJumpTimes(); }
+
  protected:
   Plugin(PluginKind kind, std::string type, std::string name);
   virtual void DoAddTo(Scene& scene) = 0;
@@ -63,6 +68,7 @@ class Plugin {
   virtual void DoCheckInitialState(const Scene&, const SimTK::State&) const {}
   virtual std::vector<std::string> DoGetAdjustables() const { return {}; }
   virtual void DoSetAdjustable(SimTK::State&, const std::string&, double) const {}
+  virtual std::vector<double> DoCalcInputJumpTimes() const { return {}; }
 
  private:
   PluginKind kind_;

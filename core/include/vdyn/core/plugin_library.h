@@ -27,7 +27,7 @@
 /// subsystem templates (Suspension, AntiRollBar) as choice families a library
 /// may add to; WheeledVehicle for FourWsVehicle. A library must return the value it
 /// was compiled with from vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 4
+#define VDYN_PLUGIN_ABI_VERSION 5
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))

@@ -34,6 +34,13 @@ struct SimulationSettings {
   double progress_interval_s = 0;
   std::function<void(const SimTK::State&, double wall_s)> progress;
 
+  /// Times (s, absolute) where an input's rate jumps (a steering profile
+  /// that is only C0, Plugin::calcInputJumpTimes): the integrator stops there
+  /// and restarts from the right (its initialisation projects the velocities
+  /// onto the new rate). Those outside (start, t_end_s) are ignored; the
+  /// report grid continues across them; the summary counts every segment.
+  std::vector<double> restart_times_s;
+
   void validate() const;
 };
 

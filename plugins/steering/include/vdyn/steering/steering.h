@@ -48,9 +48,13 @@ class SteeringCommand {
   SteerCommandValue calc(const SimTK::State& s) const { return calcAt(s.getTime()); }
   /// The value at time t_s.
   SteerCommandValue calcAt(double t_s) const;
+  /// Times (s) where the rate jumps (the command is only C0 there; at each,
+  /// calcAt gives the value from the right); empty for a C1 command.
+  std::vector<double> getRateJumpTimes() const { return DoGetRateJumpTimes(); }
 
  protected:
   virtual SteerCommandValue DoCalc(double t_s) const = 0;
+  virtual std::vector<double> DoGetRateJumpTimes() const { return {}; }
 };
 
 /// Holds a constant angle, rad (+ left, |angle| <= 1.2). setAngle() changes it
@@ -235,6 +239,10 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
   /// "angle_rad" for a plugin on a HoldCommand (HoldCommand::setAngle).
   std::vector<std::string> DoGetAdjustables() const override;
   void DoSetAdjustable(SimTK::State& state, const std::string& key, double value) const override;
+  /// The command's rate jumps (time-commanded; none when state-driven).
+  std::vector<double> DoCalcInputJumpTimes() const override {
+    return command_ ? command_->getRateJumpTimes() : std::vector<double>{};
+  }
 
  private:
   struct LawSlot {
