@@ -8,7 +8,8 @@
 //     double wishbone with its tie rods moved onto a rack;
 // (b) a time-commanded run: the rack follows k * command(t), the mean
 //     road-wheel angle the commanded road-wheel angle;
-// (c) a state-driven run under a law with a closed-form solution;
+// (c) state-driven runs: under a law with a closed-form solution, and the
+//     path controller through a lane change (SteeringActuator unchanged);
 // (d) bad data named.
 #include <gtest/gtest.h>
 
@@ -19,6 +20,8 @@
 #include "test_util.h"
 #include "vdyn/core/recorder.h"
 #include "vdyn/core/scene_file.h"
+#include "vdyn/path_control/path_control.h"
+#include "vdyn/speed/speed_hold.h"
 #include "vdyn/core/simulation.h"
 #include "vdyn/templates/macpherson_strut.h"
 #include "vdyn/templates/rack_and_pinion.h"
@@ -405,4 +408,35 @@ TEST(RackAndPinion, SceneSteeringAttachedToTheRackAxleDrivesTheRack) {
                 .find("command_angle: only a steering on a rack axle"),
             std::string::npos)
       << test::errorOf([&] { SceneDescription::fromJson(bad, "bad.json", standardRegistry()).build(); });
+}
+
+// The path controller (chapter 7's lane-change gains) through SteeringActuator
+// on the rack: the E90 changes lane.
+TEST(RackAndPinion, PathControllerSteersTheRackThroughALaneChange) {
+  WheeledVehicle car(paramsOf(e90RackData()));
+  car.addAxleSteering("front_steer", "front", SteeringStateSpec{});
+  Scene& sc = car.updScene();
+  const LaneChangeParams lp{5.0, 0.0, 40.0, 2.0};
+  PathControlParams g;
+  g.k1_rad_per_s2_per_m = 10;
+  g.k2_rad_per_s2 = 2;
+  g.k3_rad_per_s2_per_m = 100;
+  g.k4_rad_per_s2 = 5;
+  g.k5_per_s = 10;
+  g.look_ahead_s = 0.6;
+  sc.addPlugin(std::make_unique<PathControlPlugin>("path_control", "front_steer", "chassis",
+                                                   std::make_shared<LaneChangePath>(lp), g));
+  sc.addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 16.0));
+  SimTK::State s = car.makeInitialState(16.0);
+  SimulationSettings sim;
+  sim.t_end_s = 4.0;
+  sim.report_interval_s = 0.05;
+  sim.integrator.accuracy = 1e-6;
+  Recorder rec(sc, {"chassis.x_m", "chassis.y_m", "front_steer.command_rad", "front_steer.rack_travel_m"});
+  simulate(sc, s, sim, &rec);
+  double peak = 0;
+  for (double q : rec.column("front_steer.command_rad")) peak = std::max(peak, std::abs(q));
+  std::printf("rack path control: y(4 s) = %.4f m at x = %.2f m, peak command %.4f rad\n",
+              rec.column("chassis.y_m").back(), rec.column("chassis.x_m").back(), peak);
+  EXPECT_NEAR(rec.column("chassis.y_m").back(), 2.0, 0.05);
 }
