@@ -31,6 +31,7 @@
 #include "vdyn/steering/steering.h"
 #include "vdyn/steering_ratio/linear_ratio.h"
 #include "vdyn/tire/tire_model.h"
+#include "vdyn/templates/rack_and_pinion.h"
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/vehicles/anti_roll_bar.h"
 #include "vdyn/vehicles/suspension.h"
@@ -203,7 +204,8 @@ TEST(RegistryKeys, EveryChoiceAcceptsExactlyItsListedKeys) {
   const KrTable table = KrTable::fromFile(resolveDataPath("kr_table.json"));
   const std::vector<std::string> families = reg.choiceFamilies();
   EXPECT_EQ(families, (std::vector<std::string>{"anti_roll_bar_template", "rear_steer_strategy",
-                                                "sensitivity_method", "steering_command", "suspension_template"}))
+                                                "sensitivity_method", "steering_command", "steering_template",
+                                                "suspension_template"}))
       << "a new choice family: add its Base and Context to this test";
   for (const auto& family : families)
     for (const auto& type : reg.knownChoices(family)) {
@@ -222,6 +224,8 @@ TEST(RegistryKeys, EveryChoiceAcceptsExactlyItsListedKeys) {
           reg.createChoice<Suspension>(family, type, r, NoContext{}, "t.json");
         else if (family == "anti_roll_bar_template")
           reg.createChoice<AntiRollBar>(family, type, r, NoContext{}, "t.json");
+        else if (family == "steering_template")
+          reg.createChoice<RackAndPinion>(family, type, r, NoContext{}, "t.json");
       });
     }
 }

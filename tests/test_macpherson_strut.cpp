@@ -160,7 +160,8 @@ TEST(MacPhersonStrut, BadDataIsNamed) {
             "e90.json: axles.front.suspension.hardpoints_m: strut_chassis and strut_upright coincide (less than 1 um "
             "apart)");
   p = strutParams();
-  p.tie_rod = "rack";
-  EXPECT_NE(test::errorOf([&] { p.validate("w"); }).find("w.tie_rod must be \"none\" or \"chassis\", got \"rack\""),
+  p.tie_rod = "racks";
+  EXPECT_NE(test::errorOf([&] { p.validate("w"); })
+                .find("w.tie_rod must be \"none\", \"chassis\" or \"rack\", got \"racks\""),
             std::string::npos);
 }

@@ -388,7 +388,7 @@ TEST(Registry, ChoicesAreRegisteredNamesThatPluginsOfASceneFind) {
       << unknown;
   EXPECT_EQ(r.choiceFamilies(),
             (std::vector<std::string>{"anti_roll_bar_template", "rear_steer_strategy", "sensitivity_method",
-                                      "steering_command", "suspension_template"}));
+                                      "steering_command", "steering_template", "suspension_template"}));
   EXPECT_EQ(r.knownChoices("sensitivity_method"),
             (std::vector<std::string>{"fd_central", "fd_forward", "mixed", "reference"}));
   EXPECT_EQ(r.choiceInfo("steering_command", "smooth_step").fields.at(1).key, "final_rad");

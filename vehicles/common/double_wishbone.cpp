@@ -69,8 +69,8 @@ void DoubleWishboneParams::validate(const std::string& w) const {
   requirePositive(spring_stiffness_N_per_m, w + ".spring.stiffness_N_per_m");
   requireNonNegative(damper_N_s_per_m, w + ".spring.damping_N_s_per_m");
   requirePositive(spring_free_length_m, w + ".spring.free_length_m");
-  if (tie_rod != "none" && tie_rod != "chassis")
-    throw Error(w + ".tie_rod must be \"none\" or \"chassis\", got \"" + tie_rod + "\"");
+  if (tie_rod != "none" && tie_rod != "chassis" && tie_rod != "rack")
+    throw Error(w + ".tie_rod must be \"none\", \"chassis\" or \"rack\", got \"" + tie_rod + "\"");
 }
 
 const FieldTable<DoubleWishboneParams>& DoubleWishboneParams::fields() {
@@ -193,7 +193,7 @@ DoubleWishboneParams DoubleWishboneParams::fromHardpoints(const ParamReader& r) 
     p.damper_arm_point_m = h.vec3("damper_arm") - cl;
   }
   p.tie_rod = r.stringOr("tie_rod", "none");
-  if (p.tie_rod == "chassis") {
+  if (p.tie_rod == "chassis" || p.tie_rod == "rack") {
     p.tierod_chassis_point_m = h.vec3("tierod_chassis");
     p.tierod_knuckle_point_m = h.vec3("tierod_upright") - spindle;
   }
@@ -244,7 +244,8 @@ SimTK::Body::Rigid makeRigidBody(const RigidBodyParams& b) {
 }
 
 DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& chassis,
-                                         const DoubleWishboneParams& p, const std::string& prefix) {
+                                         const DoubleWishboneParams& p, const std::string& prefix,
+                                         const SimTK::MobilizedBody* rack) {
   DoubleWishboneCorner c;
   buildWishboneCorner(scene, chassis, p, prefix, c, [&](DoubleWishboneCorner& k) {
     k.knuckle = SimTK::MobilizedBody::Ball(k.lower_arm, SimTK::Transform(p.lower_ball.parent_point_m),
@@ -253,9 +254,12 @@ DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& cha
   // The loop cut at the upper ball (joint 3), closed by a constraint.
   c.upper_ball = SimTK::Constraint::Ball(c.upper_arm, p.upper_ball.parent_point_m, c.knuckle,
                                          p.upper_ball.child_point_m);
-  if (p.tie_rod == "chassis") {
+  if (p.tie_rod == "rack" && !rack) throw Error(prefix + "corner: tie_rod \"rack\" but no rack was given");
+  if (p.tie_rod != "none") {
     const Vec3 knuckle0 = wheelCentreInChassis(p);  // the knuckle frame's origin in the chassis at design
-    c.tie_rod = SimTK::Constraint::Rod(chassis, p.tierod_chassis_point_m, c.knuckle, p.tierod_knuckle_point_m,
+    // The inner end on the chassis, or on the rack (its frame the chassis frame at zero travel).
+    SimTK::MobilizedBody& inner = p.tie_rod == "rack" ? const_cast<SimTK::MobilizedBody&>(*rack) : chassis;
+    c.tie_rod = SimTK::Constraint::Rod(inner, p.tierod_chassis_point_m, c.knuckle, p.tierod_knuckle_point_m,
                                        (knuckle0 + p.tierod_knuckle_point_m - p.tierod_chassis_point_m).norm());
   }
   return c;

@@ -5,6 +5,7 @@
 
 #include "vdyn/vehicles/bicycle.h"
 #include "vdyn/vehicles/wheeled_vehicle.h"
+#include "vdyn/templates/rack_and_pinion.h"
 #include "vdyn/vehicles/quarter_car.h"
 
 namespace vdyn {
@@ -35,6 +36,12 @@ class WheeledSceneVehicle : public Vehicle {
       // An axle whose knuckles a tie rod holds offers no knuckles to steer.
       Attachment a = {{"chassis", "chassis"}, {"spin_axis", axisText(car_.suspension(ax).getSpinAxis(0))}};
       if (car_.suspension(ax).isSteerable()) a["knuckles"] = r + ".knuckle," + l + ".knuckle";
+      // An axle on a rack: a steering plugin attached to it drives the rack
+      // (typed role "rack") and measures the knuckles.
+      if (car_.rack(ax)) {
+        a["knuckles"] = r + ".knuckle," + l + ".knuckle";
+        a["rack"] = car_.params().axles[ax].name + ".rack";
+      }
       attachments_[car_.params().axles[ax].name + "_axle"] = a;
     }
     for (int c = 0; c < car_.numCorners(); ++c) {
@@ -148,6 +155,7 @@ TypeInfo info(const std::string& summary, const FieldTable<P>& data) {
 void registerVehicles(PluginRegistry& registry) {
   registerSuspensionTemplates(registry);
   registerAntiRollBarTemplates(registry);
+  registerSteeringTemplates(registry);
   for (const char* type : {"wheeled", "fourws"}) {
     TypeInfo t = info(std::string(type) == "fourws"
                           ? "the wheeled vehicle under the App. A car's name (kept so scenes naming it keep working)"

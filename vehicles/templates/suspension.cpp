@@ -6,6 +6,7 @@
 #include "vdyn/templates/double_wishbone.h"
 #include "vdyn/templates/macpherson_strut.h"
 #include "vdyn/templates/solid_axle.h"
+#include "vdyn/templates/rack_and_pinion.h"
 
 #include "vdyn/plugins/builtin.h"
 #include "vdyn/vehicles/anti_roll_bar.h"
@@ -151,6 +152,13 @@ const SimTK::MobilizedBody& Suspension::getBody(int side, const std::string& rol
   return it->second;
 }
 
+const SimTK::MobilizedBody& Suspension::getRack() const {
+  if (rack_.isEmptyHandle())
+    throw Error("suspension template '" + templateName() + "': tie_rod \"rack\" needs a rack (the axle's \"steering\": "
+                "{\"template\": \"rack_and_pinion\", ...} block)");
+  return rack_;
+}
+
 void Suspension::setPositionFrom(SimTK::State&, int, const Suspension&, const SimTK::State&, double) const {
   throw Error("suspension template '" + templateName() + "' does not start from another template's assembly");
 }
@@ -174,6 +182,7 @@ const PluginRegistry& vehiclePlugins() {
     PluginRegistry r = builtinPlugins();
     registerSuspensionTemplates(r);
     registerAntiRollBarTemplates(r);
+    registerSteeringTemplates(r);
     return r;
   }();
   return registry;

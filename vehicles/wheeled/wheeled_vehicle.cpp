@@ -93,6 +93,18 @@ std::vector<AxleParams> readAxles(const ParamReader& r, const PluginRegistry& re
       ax.anti_roll_bar_where = bar.where();
       makeAntiRollBar(registry, bar);  // validates it at load
     }
+    if (a.has("steering")) {
+      const ParamReader st = a.child("steering");
+      ax.steering = st.json();
+      ax.steering_where = st.where();
+      makeSteeringTemplate(registry, st);  // validates it at load
+      if (!susp->usesRack())
+        throw Error(st.where() + ": a rack needs the axle's suspension to have \"tie_rod\": \"rack\" (its "
+                    "template '" + susp->templateName() + "' does not)");
+    } else if (susp->usesRack()) {
+      throw Error(sb.where() + ".tie_rod: \"rack\" needs the axle to have a \"steering\": {\"template\": "
+                  "\"rack_and_pinion\", ...} block (" + a.where() + ".steering)");
+    }
     a.requireAllKeysRead();
     axles.push_back(std::move(ax));
   }
@@ -124,7 +136,9 @@ const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
                   "{NAME: {\"suspension\": {\"template\": double_wishbone|double_wishbone_reduced|..., the "
                   "template's keys (right corner; \"left\" if not its mirror)}, \"tire\": {merged over the "
                   "vehicle's tire}, \"prefixes\": [right, left] (default r<N>, l<N>), \"anti_roll_bar\": "
-                  "{\"template\": torsion_bar|..., the template's keys} (optional)}}, ordered front to rear",
+                  "{\"template\": torsion_bar|..., the template's keys} (optional), \"steering\": {\"template\": "
+                  "rack_and_pinion, its keys} (optional: a rack, the suspension's tie_rod \"rack\")}}, ordered front "
+                  "to rear",
                   [](const ParamReader&, P&) {})  // read by fromParams, with the registry
           .custom("road", "-", "{\"type\": \"flat\"}", "road: {\"type\": flat|sine, ...}",
                   [](const ParamReader& r, P& p) {
@@ -167,9 +181,30 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
   sc.setService<const Road>("road", makeRoad(p_.road));
   for (std::size_t ai = 0; ai < p_.axles.size(); ++ai) {
     const AxleParams& ap = p_.axles[ai];
-    axles_.push_back({ap.suspension.create(registry), nullptr});
+    axles_.push_back({ap.suspension.create(registry), nullptr, nullptr, 0.0});
     Suspension& susp = *axles_.back().suspension;
     if (p_.chassis_com_m != SimTK::Vec3(0)) susp.shiftChassisFrame(-p_.chassis_com_m);
+    if (!ap.steering.empty()) {
+      // The rack first: the corners' tie rods end on it.
+      const ParamReader st = ParamReader::fromJson(ap.steering, ap.steering_where);
+      Axle& axle = axles_.back();
+      axle.rack = makeSteeringTemplate(registry, st);
+      // N0 from the geometry (the data's frame: a rig on a fixed chassis).
+      RackSteeringRig rig(ap.suspension.block, ap.suspension.where, axle.rack->params(), registry);
+      axle.overall_ratio = rig.solve(0.0).overall_ratio;
+      if (!std::isfinite(axle.overall_ratio))
+        throw Error(ap.steering_where + ": the overall steering ratio at centre is not finite (the tie rods do not "
+                    "steer the wheels)");
+      if (p_.chassis_com_m != SimTK::Vec3(0)) axle.rack->shiftChassisFrame(-p_.chassis_com_m);
+      const std::string body = ap.name + ".rack";
+      susp.setRack(axle.rack->build(sc, chassis_, body));
+      auto service = std::make_shared<SteeringRack>();
+      service->body = body;
+      service->travel_per_pinion_rad_m = axle.rack->params().travel_per_pinion_rad_m;
+      service->overall_ratio = axle.overall_ratio;
+      service->travel_limit_m = axle.rack->params().travel_limit_m;
+      sc.setService<const SteeringRack>(body, service);
+    }
     const std::string prefixes[2] = {ap.prefixes[0] + ".", ap.prefixes[1] + "."};
     susp.build(sc, chassis_, prefixes, [&](int side) {
       const std::string& n = ap.prefixes[side];
@@ -228,9 +263,14 @@ int WheeledVehicle::axleIndex(const std::string& name) const {
 }
 
 void WheeledVehicle::requireSteerable(int axle, const std::string& plugin) const {
-  if (!suspension(axle).isSteerable())
+  if (!suspension(axle).isSteerable() && !rack(axle))
     throw Error("vehicle: steering plugin '" + plugin + "' steers axle '" + p_.axles[axle].name +
-                "', whose knuckles its suspension's tie rods hold (tie_rod \"chassis\")");
+                "', whose knuckles its suspension's tie rods hold (tie_rod \"chassis\") and which has no rack");
+}
+
+double WheeledVehicle::overallSteeringRatio(int axle) const {
+  if (!rack(axle)) throw Error("vehicle: axle '" + p_.axles.at(axle).name + "' has no rack (no \"steering\" block)");
+  return axles_.at(axle).overall_ratio;
 }
 
 void WheeledVehicle::throwNotTemplate(int axle, const char* what) const {
@@ -239,31 +279,42 @@ void WheeledVehicle::throwNotTemplate(int axle, const char* what) const {
 }
 
 const SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, const std::string& axle,
-                                                      std::shared_ptr<const SteeringCommand> command) {
+                                                      std::shared_ptr<const SteeringCommand> command,
+                                                      const std::string& commandAngle) {
   const int ax = axleIndex(axle);
   requireSteerable(ax, name);
-  axleSteering_.push_back({name, axle, command, 0.0});
+  axleSteering_.push_back({name, axle, command, 0.0, commandAngle});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{cornerName(2 * ax) + ".knuckle", cornerName(2 * ax + 1) + ".knuckle"},
       std::move(command), suspension(ax).getSpinAxis(0));
+  if (rack(ax)) plugin->driveRack(axle + ".rack", commandAngle);
+  else if (commandAngle != "road_wheel")
+    throw Error("vehicle: steering plugin '" + name + "': command_angle \"" + commandAngle + "\" needs a rack (axle '" +
+                axle + "' has none)");
   return static_cast<const SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
 }
 
 SteeringPlugin& WheeledVehicle::addAxleSteering(const std::string& name, const std::string& axle,
-                                                const SteeringStateSpec& state) {
+                                                const SteeringStateSpec& state, const std::string& commandAngle) {
   const int ax = axleIndex(axle);
   requireSteerable(ax, name);
-  axleSteering_.push_back({name, axle, nullptr, state.initial_angle_rad});
+  axleSteering_.push_back({name, axle, nullptr, state.initial_angle_rad, commandAngle});
   auto plugin = std::make_unique<SteeringPlugin>(
       name, "chassis", std::vector<std::string>{cornerName(2 * ax) + ".knuckle", cornerName(2 * ax + 1) + ".knuckle"},
       state, suspension(ax).getSpinAxis(0));
+  if (rack(ax)) plugin->driveRack(axle + ".rack", commandAngle);
+  else if (commandAngle != "road_wheel")
+    throw Error("vehicle: steering plugin '" + name + "': command_angle \"" + commandAngle + "\" needs a rack (axle '" +
+                axle + "' has none)");
   return static_cast<SteeringPlugin&>(scene_->addPlugin(std::move(plugin)));
 }
 
 double WheeledVehicle::totalMass() const {
   double m = p_.chassis.mass_kg;
-  for (const Axle& a : axles_)
+  for (const Axle& a : axles_) {
     for (int side = 0; side < 2; ++side) m += a.suspension->calcCornerMass(side);
+    if (a.rack) m += a.rack->params().rack_mass_kg;  // sprung, carried by the chassis
+  }
   return m;
 }
 
@@ -320,7 +371,8 @@ SimTK::State WheeledVehicle::makeInitialState(double speed, AssemblyReport* repo
     for (const AxleSteering& a : axleSteering_)
       con.addAxleSteering(a.name, a.axle,
                           std::make_shared<HoldCommand>(a.command ? a.command->calcAt(s.getTime()).angle_rad
-                                                                  : a.initial_angle_rad));
+                                                                  : a.initial_angle_rad),
+                          a.command_angle);
     // Steering plugins a scene file added through the registry (not through
     // addAxleSteering) are held in the copy the same way, in scene order:
     // without them the copy's knuckles assembled unsteered and the reduced
@@ -330,10 +382,11 @@ SimTK::State WheeledVehicle::makeInitialState(double speed, AssemblyReport* repo
       if (!sp || std::any_of(axleSteering_.begin(), axleSteering_.end(),
                              [&](const AxleSteering& a) { return a.name == sp->name(); }))
         continue;
-      const double angle = sp->isStateDriven() ? sp->getSteerBody().getDefaultAngle()
-                                               : sp->command().calcAt(s.getTime()).angle_rad;
-      con.updScene().addPlugin(std::make_unique<SteeringPlugin>(sp->name(), sp->chassisBody(), sp->knuckleBodies(),
-                                                                std::make_shared<HoldCommand>(angle), sp->spinAxis()));
+      const double angle = sp->isStateDriven() ? sp->initialAngle() : sp->command().calcAt(s.getTime()).angle_rad;
+      auto held = std::make_unique<SteeringPlugin>(sp->name(), sp->chassisBody(), sp->knuckleBodies(),
+                                                   std::make_shared<HoldCommand>(angle), sp->spinAxis());
+      if (sp->drivesRack()) held->driveRack(sp->rackBody(), sp->commandAngle());
+      con.updScene().addPlugin(std::move(held));
     }
     const SimTK::State cs = con.makeInitialState(0.0, &conReport);
     chassis_.setQ(s, con.chassis().getQ(cs));
@@ -474,6 +527,7 @@ void WheeledVehicle::useDenseRows(SimTK::State& s) const {
   for (const auto& plugin : sc.getPlugins()) {
     if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get())) {
       if (st->isStateDriven()) throw Error("vehicle: steering plugin '" + plugin->name() + "' is state-driven" + why);
+      if (st->drivesRack()) throw Error("vehicle: steering plugin '" + plugin->name() + "' drives a rack" + why);
       if (sc.getBody(st->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
         throw Error("vehicle: steering plugin '" + plugin->name() + "' is not on the chassis" + why);
       for (const std::string& k : st->knuckleBodies()) {

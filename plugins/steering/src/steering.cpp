@@ -313,6 +313,58 @@ class SteeringLawMotion : public SimTK::Motion::Custom::Implementation {
 };
 }  // namespace
 
+double headingAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& knuckle,
+                    const SimTK::UnitVec3& spinAxis_K) {
+  const SimTK::Rotation& R = chassis.getBodyRotation(s);
+  const Vec3 f = knuckle.getBodyRotation(s) * Vec3(spinAxis_K);
+  return std::atan2(-SimTK::dot(R.x(), f), SimTK::dot(R.y(), f));
+}
+
+namespace {
+/// The rack follows a time command: Phi = x - k q(t) = 0 on the rack slider's
+/// coordinate x, with its time derivatives x' - k q', x'' - k q''.
+class RackCommandConstraintImpl : public SimTK::Constraint::Custom::Implementation {
+ public:
+  RackCommandConstraintImpl(SimTK::SimbodyMatterSubsystem& matter, const SimTK::MobilizedBody& rack, double k,
+                            double limit, std::shared_ptr<const SteeringCommand> command, std::string who)
+      : Implementation(matter, 1, 0, 0), k_(k), limit_(limit), command_(std::move(command)), who_(std::move(who)) {
+    M_ = addConstrainedMobilizer(rack);
+  }
+  Implementation* clone() const override { return new RackCommandConstraintImpl(*this); }
+  void calcPositionErrors(const SimTK::State& s, const SimTK::Array_<SimTK::Transform, SimTK::ConstrainedBodyIndex>&,
+                          const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& q,
+                          SimTK::Array_<SimTK::Real>& perr) const override {
+    const double x = k_ * command_->calc(s).angle_rad;
+    if (!(std::abs(x) <= limit_))
+      throw Error("steering plugin '" + who_ + "': the command asks a rack travel of " + formatValue(x) +
+                  " m at t = " + formatValue(s.getTime()) + " s, beyond rack_travel_limit_m " + formatValue(limit_));
+    perr[0] = getOneQ(s, q, M_, SimTK::MobilizerQIndex(0)) - x;
+  }
+  void calcPositionDotErrors(const SimTK::State& s, const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
+                             const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qdot,
+                             SimTK::Array_<SimTK::Real>& pverr) const override {
+    pverr[0] = getOneQDot(s, qdot, M_, SimTK::MobilizerQIndex(0)) - k_ * command_->calc(s).rate_rad_s;
+  }
+  void calcPositionDotDotErrors(const SimTK::State& s,
+                                const SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
+                                const SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qdotdot,
+                                SimTK::Array_<SimTK::Real>& paerr) const override {
+    paerr[0] = getOneQDotDot(s, qdotdot, M_, SimTK::MobilizerQIndex(0)) - k_ * command_->calc(s).accel_rad_s2;
+  }
+  void addInPositionConstraintForces(const SimTK::State& s, const SimTK::Array_<SimTK::Real>& multipliers,
+                                     SimTK::Array_<SimTK::SpatialVec, SimTK::ConstrainedBodyIndex>&,
+                                     SimTK::Array_<SimTK::Real, SimTK::ConstrainedQIndex>& qForces) const override {
+    addInOneQForce(s, M_, SimTK::MobilizerQIndex(0), multipliers[0], qForces);
+  }
+
+ private:
+  SimTK::ConstrainedMobilizerIndex M_;
+  double k_, limit_;
+  std::shared_ptr<const SteeringCommand> command_;
+  std::string who_;
+};
+}  // namespace
+
 double steeringAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& knuckle,
                      const SimTK::UnitVec3& spinAxis_K) {
   const Vec3 b = chassis.getBodyRotation(s).x();
@@ -373,11 +425,27 @@ void SteeringPlugin::DoSetAccelerationLaw(std::shared_ptr<const SteeringLaw> law
 bool SteeringPlugin::DoHasAccelerationLaw() const { return slot_->law != nullptr; }
 
 double SteeringPlugin::DoGetAngle(const SimTK::State& s) const {
+  if (drivesRack()) return rackBody_.getOneQ(s, 0) / k_;
   return steer_.getAngle(s);
 }
 
 double SteeringPlugin::DoGetRate(const SimTK::State& s) const {
+  if (drivesRack()) return rackBody_.getOneU(s, 0) / k_;
   return steer_.getRate(s);
+}
+
+void SteeringPlugin::driveRack(std::string rackBody, std::string commandAngle) {
+  if (rackBody.empty()) throw Error("steering plugin '" + name() + "': empty rack name");
+  if (commandAngle != "road_wheel" && commandAngle != "steering_wheel")
+    throw Error("steering plugin '" + name() + "': command_angle must be \"road_wheel\" or \"steering_wheel\", got \"" +
+                commandAngle + "\"");
+  rack_ = std::move(rackBody);
+  commandAngle_ = std::move(commandAngle);
+}
+
+SimTK::MobilizedBodyIndex SteeringPlugin::stateBodyIndex() const {
+  assert(stateDriven_);
+  return drivesRack() ? rackBody_.getMobilizedBodyIndex() : steer_.getMobilizedBodyIndex();
 }
 
 double SteeringPlugin::DoCalcAcceleration(const SimTK::State& s) const {
@@ -437,7 +505,87 @@ void SteeringPlugin::addStateDriven(Scene& scene) {
                    }});
 }
 
+void SteeringPlugin::addRack(Scene& scene) {
+  const SteeringRack rack = *scene.getService<const SteeringRack>(rack_);
+  const double c = rack.travel_per_pinion_rad_m, N0 = rack.overall_ratio;
+  k_ = commandAngle_ == "road_wheel" ? c * N0 : c;
+  if (!std::isfinite(k_) || k_ == 0)
+    throw Error("steering plugin '" + name() + "': rack '" + rack_ + "' has c = " + formatValue(c) + " m/rad, N0 = " +
+                formatValue(N0) + " (no finite non-zero rack travel per command radian)");
+  rackBody_ = scene.getBody(rack.body);
+  SimTK::MobilizedBody::Slider& slider =
+      SimTK::MobilizedBody::Slider::updDowncast(const_cast<SimTK::MobilizedBody&>(scene.getBody(rack.body)));
+  const double limit = rack.travel_limit_m, k = k_;
+  const std::string who = name();
+  if (stateDriven_) {
+    const double x0 = k * state_.initial_angle_rad;
+    if (!(std::abs(x0) <= limit))
+      throw Error("steering plugin '" + who + "': initial_rad " + formatValue(state_.initial_angle_rad) +
+                  " asks a rack travel of " + formatValue(x0) + " m, beyond rack_travel_limit_m " + formatValue(limit));
+    slider.setDefaultQ(x0);
+    const std::weak_ptr<LawSlot> weakSlot = slot_;
+    const SimTK::MobilizedBody rb = slider;
+    SimTK::Motion::Custom(slider, new SteeringLawMotion([weakSlot, who, k, rb, limit](const SimTK::State& s) {
+      const auto slot = weakSlot.lock();
+      if (!slot || !slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
+      // The law's integrated rack travel past the rack's limit: the mechanism ends there.
+      if (!(std::abs(rb.getOneQ(s, 0)) <= limit))
+        throw Error("steering plugin '" + who + "': the law '" + slot->law->name() + "' drove the rack to " +
+                    formatValue(rb.getOneQ(s, 0)) + " m at t = " + formatValue(s.getTime()) +
+                    " s, beyond rack_travel_limit_m " + formatValue(limit));
+      return k * slot->law->calcAcceleration(s);
+    }));
+  } else {
+    const double x0 = k * command_->calcAt(0).angle_rad;
+    if (!(std::abs(x0) <= limit))
+      throw Error("steering plugin '" + who + "': the command at t = 0 asks a rack travel of " + formatValue(x0) +
+                  " m, beyond rack_travel_limit_m " + formatValue(limit));
+    slider.setDefaultQ(x0);
+    SimTK::Constraint::Custom(new RackCommandConstraintImpl(scene.updMatter(), slider, k, limit, command_, who));
+  }
+  const SimTK::MobilizedBody r = rackBody_;
+  const SimTK::MobilizedBody chassis = scene.getBody(chassis_);
+  std::vector<SimTK::MobilizedBody> knuckles;
+  for (const auto& kn : knuckles_) knuckles.push_back(scene.getBody(kn));
+  const SimTK::UnitVec3 axis = spin_K_;
+  if (stateDriven_) {
+    const auto slot = slot_;
+    scene.addOutput({name() + ".command_rad", "rad", SimTK::Stage::Position,
+                     [r, k](const SimTK::State& s) { return r.getOneQ(s, 0) / k; }});
+    scene.addOutput({name() + ".rate_rad_s", "rad/s", SimTK::Stage::Velocity,
+                     [r, k](const SimTK::State& s) { return r.getOneU(s, 0) / k; }});
+    scene.addOutput({name() + ".accel_rad_s2", "rad/s^2", SimTK::Stage::Velocity, [slot, who](const SimTK::State& s) {
+                       if (!slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
+                       return slot->law->calcAcceleration(s);
+                     }});
+  } else {
+    const auto cmd = command_;
+    scene.addOutput({name() + ".command_rad", "rad", SimTK::Stage::Time,
+                     [cmd](const SimTK::State& s) { return cmd->calc(s).angle_rad; }});
+  }
+  scene.addOutput({name() + ".angle_rad", "rad", SimTK::Stage::Position, [chassis, knuckles, axis](const SimTK::State& s) {
+                     double sum = 0;
+                     for (const auto& kn : knuckles) sum += headingAngle(s, chassis, kn, axis);
+                     return sum / double(knuckles.size());
+                   }});
+  scene.addOutput({name() + ".rack_travel_m", "m", SimTK::Stage::Position,
+                   [r](const SimTK::State& s) { return r.getOneQ(s, 0); }});
+  scene.addOutput({name() + ".steering_wheel_rad", "rad", SimTK::Stage::Position,
+                   [r, c](const SimTK::State& s) { return r.getOneQ(s, 0) / c; }});
+  for (std::size_t i = 0; i < knuckles_.size(); ++i) {
+    const std::string& kn = knuckles_[i];
+    const std::string corner = kn.substr(0, kn.find('.'));
+    const SimTK::MobilizedBody b = knuckles[i];
+    scene.addOutput({name() + "." + corner + "_angle_rad", "rad", SimTK::Stage::Position,
+                     [chassis, b, axis](const SimTK::State& s) { return headingAngle(s, chassis, b, axis); }});
+  }
+}
+
 void SteeringPlugin::DoAddTo(Scene& scene) {
+  if (drivesRack()) {
+    addRack(scene);
+    return;
+  }
   if (stateDriven_) {
     addStateDriven(scene);
     return;
@@ -459,7 +607,7 @@ std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene) {
   std::vector<SimTK::MobilizedBodyIndex> bodies;
   for (const auto& p : scene.getPlugins())
     if (const auto* st = dynamic_cast<const SteeringPlugin*>(p.get()); st && st->isStateDriven())
-      bodies.push_back(st->getSteerBody().getMobilizedBodyIndex());
+      bodies.push_back(st->stateBodyIndex());
   return bodies;
 }
 
@@ -473,6 +621,7 @@ struct SteeringEntry {
   std::shared_ptr<const SteeringCommand> command;
   bool state_driven = false;
   double initial_rad = 0;
+  std::string command_angle;  ///< empty: not given ("road_wheel" on a rack)
 };
 
 const FieldTable<SteeringEntry>& steeringFields() {
@@ -495,7 +644,11 @@ const FieldTable<SteeringEntry>& steeringFields() {
                       e.command = makeSteeringCommand(c, e.registry);
                     }
                   })
-          .sample("{\"type\": \"hold\"}");
+          .sample("{\"type\": \"hold\"}")
+          .string("command_angle", &SteeringEntry::command_angle,
+                  "on a rack axle (bound \"rack\"): road_wheel (default: the command is a road-wheel angle, the "
+                  "steering-wheel angle N0 times it) | steering_wheel (the command is the steering-wheel angle); "
+                  "rad, + left");
   return t;
 }
 
@@ -521,12 +674,25 @@ void registerSteeringPlugins(PluginRegistry& registry) {
         if (spec.bindings.count("spin_axis")) e.spin_axis = parseAxis(spec.bindings.at("spin_axis"), spec.params.where());
         if (e.knuckles.empty()) throw Error(spec.params.at("knuckles") + ": no knuckles (list them or attach an axle)");
         const SimTK::UnitVec3 spin(e.spin_axis);
+        std::unique_ptr<SteeringPlugin> p;
         if (e.state_driven) {
           SteeringStateSpec st;
           st.initial_angle_rad = e.initial_rad;
-          return std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, st, spin);
+          p = std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, st, spin);
+        } else {
+          p = std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, e.command, spin);
         }
-        return std::make_unique<SteeringPlugin>(spec.name, e.chassis, e.knuckles, e.command, spin);
+        if (spec.bindings.count("rack")) {
+          try {
+            p->driveRack(spec.bindings.at("rack"), e.command_angle.empty() ? "road_wheel" : e.command_angle);
+          } catch (const Error& err) {
+            throw Error(spec.params.at("command_angle") + ": " + err.what());
+          }
+        } else if (!e.command_angle.empty()) {
+          throw Error(spec.params.at("command_angle") + ": only a steering on a rack axle (attach an axle with a "
+                      "\"steering\" rack) takes a command_angle");
+        }
+        return p;
       },
       typeInfo("steering angle of knuckles (A.1)-(A.4) held on a time command (holonomic constraint) or "
                "state-driven by a controller; outputs <name>.angle_rad, <name>.command_rad",

@@ -25,8 +25,10 @@
 /// in PluginRegistry, Vehicle::getConcrete/derivedData. 3: FieldInfo::type; every
 /// registration takes its TypeInfo (typeInfo(summary, table)). 4: the vehicles'
 /// subsystem templates (Suspension, AntiRollBar) as choice families a library
-/// may add to; WheeledVehicle for FourWsVehicle. A library must return the value it
-/// was compiled with from vdyn_plugin_abi_version().
+/// may add to; WheeledVehicle for FourWsVehicle. 5: Suspension::usesRack/setRack
+/// (the rack and pinion), SteeringPlugin's rack members, Plugin::calcInputJumpTimes
+/// and SteeringCommand::getRateJumpTimes. A library must return the value it was
+/// compiled with from vdyn_plugin_abi_version().
 #define VDYN_PLUGIN_ABI_VERSION 5
 
 /// Declares the two entry points with C linkage and default visibility.

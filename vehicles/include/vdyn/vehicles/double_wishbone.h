@@ -76,7 +76,9 @@ struct DoubleWishboneParams {
   SimTK::Vec3 damper_chassis_point_m{0, 0, 0}, damper_arm_point_m{0, 0, 0};
   /// "none" (the knuckle turns freely about its kingpin, for a steering
   /// plugin) or "chassis": a fixed-length tie rod from tierod_chassis_point_m
-  /// (chassis frame) to tierod_knuckle_point_m (knuckle frame) holds its steer.
+  /// (chassis frame) to tierod_knuckle_point_m (knuckle frame) holds its steer;
+  /// or "rack": the same rod, its inner end on the axle's steering rack (the
+  /// rack frame is the chassis frame at zero rack travel; rack_and_pinion.h).
   std::string tie_rod = "none";
   SimTK::Vec3 tierod_chassis_point_m{0, 0, 0}, tierod_knuckle_point_m{0, 0, 0};
 
@@ -113,9 +115,11 @@ struct DoubleWishboneCorner {
 
 /// Adds the corner's bodies, joints, loop constraint and spring-damper to the
 /// scene under `chassis`; bodies are registered as <prefix>lower_arm,
-/// <prefix>knuckle, <prefix>upper_arm, <prefix>wheel.
+/// <prefix>knuckle, <prefix>upper_arm, <prefix>wheel. `rack`: the body the
+/// tie rod's inner end sits on for tie_rod "rack" (required then).
 DoubleWishboneCorner buildDoubleWishbone(Scene& scene, SimTK::MobilizedBody& chassis,
-                                         const DoubleWishboneParams& p, const std::string& prefix);
+                                         const DoubleWishboneParams& p, const std::string& prefix,
+                                         const SimTK::MobilizedBody* rack = nullptr);
 
 /// Position of the knuckle (and wheel) origin in the chassis frame in the
 /// tabulated configuration, following the tree joints from the chassis.

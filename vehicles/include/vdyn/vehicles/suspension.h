@@ -94,6 +94,16 @@ class Suspension {
   /// True if the knuckles turn freely about their kingpins (no tie rod holds
   /// them): only then may a steering plugin steer the axle.
   virtual bool isSteerable() const = 0;
+  /// True if a corner's tie rod ends on a steering rack (data "tie_rod":
+  /// "rack"): the vehicle then builds the axle's rack (its "steering" block,
+  /// vdyn/templates/rack_and_pinion.h) before the corners and hands its body
+  /// over with setRack(). A rack axle is not isSteerable(): a steering plugin
+  /// drives its rack, not its knuckles.
+  virtual bool usesRack() const { return false; }
+  /// The rack body the tie rods' inner ends sit on (before build(), when
+  /// usesRack()): its frame coincides with the chassis frame at zero rack
+  /// travel, so a chassis-frame tie-rod point TIEROD_C is its station there.
+  void setRack(const SimTK::MobilizedBody& rack) { rack_ = rack; }
   /// The built corner for a kinematics sweep; false if the template has no
   /// such description (the vehicle report then names it).
   virtual bool getKinematicCorner(int /*side*/, KinematicCorner* /*k*/) const { return false; }
@@ -129,6 +139,8 @@ class Suspension {
   explicit Suspension(std::string templateName) : template_(std::move(templateName)) {}
   virtual void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) = 0;
   virtual void DoShiftChassisFrame(const SimTK::Vec3& offset_m) = 0;
+  /// The rack given by setRack(); throws Error naming the template if none was.
+  const SimTK::MobilizedBody& getRack() const;
 
   /// A spring's two mounts: a station on each of two bodies (body frames, m).
   struct SpringMount {
@@ -145,6 +157,7 @@ class Suspension {
                       const SpringStopParams& stops);
 
  private:
+  SimTK::MobilizedBody rack_;  ///< empty handle: no rack
   std::string template_;
   SpringMount mounts_[2];
   std::map<std::string, SimTK::MobilizedBody> bodies_[2];  ///< by role, filled by build()

@@ -14,7 +14,8 @@
 //    "tire": {"plugin": KIND, "params": {...}},     // every axle's, unless its own
 //    "axles": {"front": {"suspension": {"template": "double_wishbone", ...},
 //                        "tire": {...},              // optional, merged over "tire"
-//                        "anti_roll_bar": {"template": "torsion_bar", ...}},  // optional
+//                        "anti_roll_bar": {"template": "torsion_bar", ...},  // optional
+//                        "steering": {"template": "rack_and_pinion", ...}},   // optional: a rack
 //              "rear": {...}},
 //    "road": {...}, "gravity_m_per_s2": 9.81, "forward_dynamics": "simbody"}
 // Axles are ordered front to rear by their wheel centres' xi; a corner's
@@ -37,6 +38,7 @@
 #include "vdyn/templates/double_wishbone.h"
 #include "vdyn/vehicles/suspension.h"
 #include "vdyn/vehicles/anti_roll_bar.h"
+#include "vdyn/templates/rack_and_pinion.h"
 
 namespace vdyn {
 
@@ -63,6 +65,12 @@ struct AxleParams {
   /// an empty block: none.
   Json anti_roll_bar = Json::object();
   std::string anti_roll_bar_where = "anti_roll_bar";  ///< its data-file location, for messages
+  /// Data key "steering": {"template": "rack_and_pinion", ...}
+  /// (rack_and_pinion.h): the axle's rack, whose suspension has "tie_rod":
+  /// "rack"; an empty block: none (the knuckles steered directly, (A.1), if
+  /// the suspension has no tie rod).
+  Json steering = Json::object();
+  std::string steering_where = "steering";  ///< its data-file location, for messages
   double wheel_centre_x_m = 0;         ///< xi of the right wheel centre (tabulated), for the order
 };
 
@@ -163,11 +171,25 @@ class WheeledVehicle {
   SimTK::State makeInitialState(double speed_m_s = 0.0, AssemblyReport* report = nullptr) const;
 
   /// Adds a steering plugin that commands both wheels of `axle` ("front",
-  /// "rear") with the same angle; call before making states.
+  /// "rear") with the same angle; call before making states. On an axle with
+  /// a rack ("steering" block) the plugin drives the rack instead
+  /// (SteeringPlugin::driveRack): `commandAngle` "road_wheel" (the command is
+  /// a road-wheel angle; steering-wheel angle = N0 times it) or
+  /// "steering_wheel" (the command is the steering-wheel angle); rad, + left.
+  /// Throws Error naming the plugin on an axle that neither steers freely nor
+  /// has a rack.
   const SteeringPlugin& addAxleSteering(const std::string& name, const std::string& axle,
-                                        std::shared_ptr<const SteeringCommand> command);
+                                        std::shared_ptr<const SteeringCommand> command,
+                                        const std::string& commandAngle = "road_wheel");
   /// The same, state-driven: a controller plugin sets delta'' (see SteeringPlugin).
-  SteeringPlugin& addAxleSteering(const std::string& name, const std::string& axle, const SteeringStateSpec& state);
+  SteeringPlugin& addAxleSteering(const std::string& name, const std::string& axle, const SteeringStateSpec& state,
+                                  const std::string& commandAngle = "road_wheel");
+  /// The rack of an axle (built with its "steering" block), or null if it has none.
+  const RackAndPinion* rack(int axle) const { return axles_.at(axle).rack.get(); }
+  /// The overall steering ratio at centre N0 of a rack axle (d(theta_sw)/d(mean
+  /// road-wheel angle) at zero rack travel and design wheel travel; the rack's
+  /// scene service SteeringRack carries it too); throws Error without a rack.
+  double overallSteeringRatio(int axle) const;
 
   double totalMass() const;
   /// Mobilities minus constraint equations (the chassis quaternion counts as 3).
@@ -210,6 +232,8 @@ class WheeledVehicle {
   struct Axle {
     std::unique_ptr<Suspension> suspension;
     std::unique_ptr<AntiRollBar> anti_roll_bar;  ///< null: none
+    std::unique_ptr<RackAndPinion> rack;         ///< null: none
+    double overall_ratio = 0;                    ///< N0 of the rack
   };
   std::vector<Axle> axles_;
   ReducedDenseRows* dense_ = nullptr;  ///< owned by its Force::Custom
@@ -219,6 +243,7 @@ class WheeledVehicle {
     std::string axle;
     std::shared_ptr<const SteeringCommand> command;  ///< null: state-driven
     double initial_angle_rad;
+    std::string command_angle;
   };
   std::vector<AxleSteering> axleSteering_;
   std::vector<const TirePlugin*> tires_;

@@ -55,7 +55,8 @@ TypeInfo wishboneInfo(const std::string& summary) {
                       "com_m (chassis frame) and joints is not given"});
   t.fields.push_back({"tie_rod", "-", "\"none\"",
                       "(hardpoint form) none (the knuckle steers freely, for a steering plugin) | chassis (a "
-                      "fixed-length rod tierod_chassis - tierod_upright holds it)"});
+                      "fixed-length rod tierod_chassis - tierod_upright holds it) | rack (the same rod, its inner end "
+                      "on the axle's steering rack: the axle needs a \"steering\" block)"});
   t.fields.push_back({"camber_rad", "rad", "0", "(hardpoint form) static camber, + top of the wheel outward"});
   t.fields.push_back({"toe_in_rad", "rad", "0", "(hardpoint form) static toe, + toe-in"});
   t.fields.push_back({"left", "-", "{}",
@@ -91,7 +92,13 @@ void registerDoubleWishboneTemplates(PluginRegistry& registry) {
 
 const FieldTable<DoubleWishboneParams>& DoubleWishboneSuspension::fields() { return DoubleWishboneParams::fields(); }
 
-void DoubleWishboneSuspension::setLeftCorner(const DoubleWishboneParams& left) { params_[1] = left; }
+void DoubleWishboneSuspension::setLeftCorner(const DoubleWishboneParams& left) {
+  // One rack moves both tie rods: both corners on it or neither.
+  if ((left.tie_rod == "rack") != (params_[0].tie_rod == "rack"))
+    throw Error(templateName() + ": left.tie_rod \"" + left.tie_rod + "\" and the right corner's \"" +
+                params_[0].tie_rod + "\": a rack takes both corners' tie rods or neither");
+  params_[1] = left;
+}
 
 void DoubleWishboneSuspension::DoShiftChassisFrame(const SimTK::Vec3& d) {
   for (DoubleWishboneParams& p : params_) {
@@ -128,8 +135,9 @@ double DoubleWishboneSuspension::calcLoopGap(const SimTK::State& s, int side) co
   double gap = (corners_[side].upper_arm.findStationLocationInGround(s, j.parent_point_m) -
                 corners_[side].knuckle.findStationLocationInGround(s, j.child_point_m))
                    .norm();
-  if (p.tie_rod == "chassis") {
-    const SimTK::MobilizedBody& chassis = corners_[side].lower_arm.getParentMobilizedBody();
+  if (p.tie_rod != "none") {
+    const SimTK::MobilizedBody& chassis =
+        p.tie_rod == "rack" ? getRack() : corners_[side].lower_arm.getParentMobilizedBody();
     const double length = (wheelCentreInChassis(p) + p.tierod_knuckle_point_m - p.tierod_chassis_point_m).norm();
     gap = std::max(gap, std::abs((corners_[side].knuckle.findStationLocationInGround(s, p.tierod_knuckle_point_m) -
                                   chassis.findStationLocationInGround(s, p.tierod_chassis_point_m))
@@ -159,7 +167,8 @@ Suspension::SpringMount DoubleWishboneSuspension::springMount(const SimTK::Mobil
 
 void DoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side,
                                              const std::string& prefix) {
-  corners_[side] = buildDoubleWishbone(scene, chassis, params_[side], prefix);
+  corners_[side] = buildDoubleWishbone(scene, chassis, params_[side], prefix,
+                                       params_[side].tie_rod == "rack" ? &getRack() : nullptr);
   addSpringMount(scene, side, prefix, springMount(chassis, corners_[side].lower_arm, params_[side]),
                  params_[side].stops);
 }

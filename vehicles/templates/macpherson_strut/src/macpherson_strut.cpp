@@ -35,9 +35,9 @@ void MacPhersonStrutParams::validate(const std::string& w) const {
   requireApart(lca_front_m, lca_back_m, w + ".hardpoints_m: lca_front and lca_back");
   requireApart(strut_chassis_m, strut_upright_m, w + ".hardpoints_m: strut_chassis and strut_upright");
   requireApart(lca_upright_m, strut_chassis_m, w + ".hardpoints_m: lca_upright and strut_chassis");
-  if (tie_rod != "none" && tie_rod != "chassis")
-    throw Error(w + ".tie_rod must be \"none\" or \"chassis\", got \"" + tie_rod + "\"");
-  if (tie_rod == "chassis") requireApart(tierod_chassis_m, tierod_upright_m, w + ".hardpoints_m: tie rod ends");
+  if (tie_rod != "none" && tie_rod != "chassis" && tie_rod != "rack")
+    throw Error(w + ".tie_rod must be \"none\", \"chassis\" or \"rack\", got \"" + tie_rod + "\"");
+  if (tie_rod != "none") requireApart(tierod_chassis_m, tierod_upright_m, w + ".hardpoints_m: tie rod ends");
   if (!(std::abs(camber_rad) < 0.5)) throw Error(w + ".camber_rad must lie in (-0.5, 0.5) rad, got " + formatValue(camber_rad));
   if (!(std::abs(toe_in_rad) < 0.5)) throw Error(w + ".toe_in_rad must lie in (-0.5, 0.5) rad, got " + formatValue(toe_in_rad));
   requirePositive(spring_stiffness_N_per_m, w + ".spring.stiffness_N_per_m");
@@ -83,7 +83,9 @@ const FieldTable<MacPhersonStrutParams>& MacPhersonStrutParams::fields() {
                       "strut_upright": [-0.0051, -0.6198, -0.0013], "spindle": [0, -0.75, 0]})")
           .string("tie_rod", &P::tie_rod,
                   "none (the upright turns freely about its kingpin: steer it with a steering plugin) | chassis (a "
-                  "fixed-length rod from hardpoint tierod_chassis to tierod_upright holds it)")
+                  "fixed-length rod from hardpoint tierod_chassis to tierod_upright holds it) | rack (the same rod, "
+                  "its inner end tierod_chassis (at zero rack travel) on the axle's steering rack: the axle needs a "
+                  "\"steering\" block)")
           .number("camber_rad", &P::camber_rad, "rad", "static camber of the wheel, + top outward")
           .number("toe_in_rad", &P::toe_in_rad, "rad", "static toe of the wheel, + toe-in")
           .custom("spring", "-", "required",
@@ -144,10 +146,11 @@ double MacPhersonStrutSuspension::calcLoopGap(const SimTK::State& s, int side) c
   const Vec3 low = c.upright.findStationLocationInGround(s, p.strut_upright_m - p.upright.com_m);
   const Vec3 dir = c.upright.getBodyRotation(s) * (p.strut_chassis_m - p.strut_upright_m).normalize();
   double gap = SimTK::cross(top - low, dir).norm();
-  if (p.tie_rod == "chassis") {
+  if (p.tie_rod != "none") {
+    const SimTK::MobilizedBody& inner = p.tie_rod == "rack" ? getRack() : chassis;
     const double length = (p.tierod_upright_m - p.tierod_chassis_m).norm();
     const double now = (c.upright.findStationLocationInGround(s, p.tierod_upright_m - p.upright.com_m) -
-                        chassis.findStationLocationInGround(s, p.tierod_chassis_m))
+                        inner.findStationLocationInGround(s, p.tierod_chassis_m))
                            .norm();
     gap = std::max(gap, std::abs(now - length));
   }
@@ -172,8 +175,11 @@ void MacPhersonStrutSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody
   // fixed in the upright, passes through the top mount.
   c.strut = SimTK::Constraint::PointOnLine(c.upright, SimTK::UnitVec3(p.strut_chassis_m - p.strut_upright_m),
                                            p.strut_upright_m - cu, chassis, p.strut_chassis_m);
-  if (p.tie_rod == "chassis")
-    c.tie_rod = SimTK::Constraint::Rod(chassis, p.tierod_chassis_m, c.upright, p.tierod_upright_m - cu,
+  // The tie rod's inner end on the chassis, or on the rack (whose frame is
+  // the chassis frame at zero rack travel: the same station).
+  if (p.tie_rod != "none")
+    c.tie_rod = SimTK::Constraint::Rod(p.tie_rod == "rack" ? const_cast<SimTK::MobilizedBody&>(getRack()) : chassis,
+                                       p.tierod_chassis_m, c.upright, p.tierod_upright_m - cu,
                                        (p.tierod_upright_m - p.tierod_chassis_m).norm());
   c.spring = SimTK::Force::TwoPointLinearSpring(scene.updForces(), chassis, p.strut_chassis_m, c.upright,
                                                 p.strut_upright_m - cu, p.spring_stiffness_N_per_m,

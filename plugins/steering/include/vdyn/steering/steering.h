@@ -190,6 +190,26 @@ class SteeringConstraintImpl : public SimTK::Constraint::Custom::Implementation 
   std::shared_ptr<const SteeringCommand> command_;
 };
 
+/// A steering rack a vehicle built (rack_and_pinion.h), as a steering plugin
+/// sees it: the vehicle sets it as the scene service named `body` (the rack's
+/// Slider along chassis +y, its coordinate the rack travel x, m). The pinion
+/// (steering-wheel) angle theta_sw (rad, + counter-clockwise seen by the
+/// driver = steering left) moves the rack by x = c theta_sw.
+struct SteeringRack {
+  std::string body;                     ///< the rack body's scene name ("front.rack")
+  double travel_per_pinion_rad_m = 0;   ///< c, m/rad: chassis +y per +1 rad of theta_sw (signed)
+  /// N0 = d(theta_sw)/d(mean road-wheel angle) at zero rack travel and design
+  /// wheel travel (the overall ratio at centre, computed from the geometry).
+  double overall_ratio = 0;
+  double travel_limit_m = 0;            ///< |x| allowed, m (a command beyond it is an Error)
+};
+
+/// Road-wheel (heading) angle of a wheel, ISO 8855: atan2(-x_B . s, y_B . s),
+/// s the spin axis (pointing left), rad, + left. Equals steeringAngle() while
+/// s stays in the chassis x-y plane; differs by the camber's effect otherwise.
+double headingAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& knuckle,
+                    const SimTK::UnitVec3& spinAxis_K);
+
 /// Measured steering angle of a wheel: asin(-x_chassis . s_knuckle), rad.
 double steeringAngle(const SimTK::State& s, const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& knuckle,
                      const SimTK::UnitVec3& spinAxis_K);
@@ -226,6 +246,31 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
   /// State-driven only: the steer body (added to the scene as <name>.steer).
   const SimTK::MobilizedBody::Pin& getSteerBody() const;
 
+  /// Drives the rack `rackBody` (a SteeringRack scene service of that name,
+  /// set by the vehicle) instead of the knuckles; before the plugin is added.
+  /// The knuckles are then only measured. The command (time or state) is an
+  /// angle in `commandAngle` units: "road_wheel" (default: theta_sw = N0 times
+  /// the command) or "steering_wheel" (theta_sw = the command); rad, + left.
+  /// Rack travel x = k q with k = c N0 or c, q the command: time-commanded,
+  /// a holonomic constraint x - k q(t) = 0 (exact at position, velocity and
+  /// acceleration); state-driven, x is the state, getAngle() = x / k and the
+  /// law prescribes x'' = k q''. Outputs besides command_rad: angle_rad (mean
+  /// measured road-wheel heading angle of the knuckles, headingAngle()),
+  /// steering_wheel_rad (x / c), rack_travel_m (x), <corner>_angle_rad per
+  /// knuckle (its prefix: rf_angle_rad), and rate_rad_s, accel_rad_s2 when
+  /// state-driven.
+  void driveRack(std::string rackBody, std::string commandAngle = "road_wheel");
+  /// True if the plugin drives a rack (driveRack()).
+  bool drivesRack() const { return !rack_.empty(); }
+  const std::string& rackBody() const { return rack_; }
+  const std::string& commandAngle() const { return commandAngle_; }
+  /// State-driven: the body whose one coordinate is the state (the steer
+  /// body, or the rack when the plugin drives one): a vehicle locks it while
+  /// it assembles (steeringStateBodies()). After the plugin is added.
+  SimTK::MobilizedBodyIndex stateBodyIndex() const;
+  /// State-driven: the initial command angle (rad, + left, command units).
+  double initialAngle() const { return state_.initial_angle_rad; }
+
  protected:
   void DoAddTo(Scene& scene) override;
   void DoInitialize(const Scene& scene, SimTK::State& state) const override;
@@ -249,6 +294,7 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
     std::shared_ptr<const SteeringLaw> law;
   };
   void addStateDriven(Scene& scene);
+  void addRack(Scene& scene);
   std::string chassis_;
   std::vector<std::string> knuckles_;
   std::shared_ptr<const SteeringCommand> command_;
@@ -257,6 +303,9 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
   SteeringStateSpec state_;
   std::shared_ptr<LawSlot> slot_ = std::make_shared<LawSlot>();
   SimTK::MobilizedBody::Pin steer_;
+  std::string rack_, commandAngle_ = "road_wheel";
+  SimTK::MobilizedBody rackBody_;  ///< the rack's slider, once added
+  double k_ = 1;                   ///< rack travel per command radian, m/rad
 };
 
 /// Mobilizers of the steer bodies of every state-driven steering plugin of the
@@ -266,6 +315,9 @@ std::vector<SimTK::MobilizedBodyIndex> steeringStateBodies(const Scene& scene);
 
 /// Registers "steering" (and the commands, registerSteeringCommands): {"chassis": "chassis", "knuckles": ["rf.knuckle", "lf.knuckle"],
 /// "spin_axis": [0, 1, 0], "command": {...}} (chassis and knuckles may be bound).
+/// A binding "rack" (an axle on a rack offers it) makes it drive that rack
+/// (SteeringPlugin::driveRack, its "command_angle": "road_wheel" |
+/// "steering_wheel").
 /// A command {"type": "state", "initial_rad": 0} makes it state-driven (a
 /// controller plugin then sets its law).
 void registerSteeringPlugins(PluginRegistry& registry);

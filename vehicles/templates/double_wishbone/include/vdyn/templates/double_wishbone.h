@@ -35,6 +35,7 @@ class DoubleWishboneSuspension : public Suspension {
   double calcLoopGap(const SimTK::State& s, int side) const override;
   bool getKinematicCorner(int side, KinematicCorner* k) const override;
   bool isSteerable() const override { return params_[0].tie_rod == "none" && params_[1].tie_rod == "none"; }
+  bool usesRack() const override { return params_[0].tie_rod == "rack"; }
 
  protected:
   DoubleWishboneSuspension(std::string name, const DoubleWishboneParams& right)

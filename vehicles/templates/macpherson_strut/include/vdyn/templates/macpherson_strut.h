@@ -8,7 +8,8 @@
 // joint). The spring-damper acts between the top mount and the upright along
 // the strut. The tie rod is optional: "tie_rod": "chassis" holds the upright's
 // steer by a fixed-length rod from a chassis point (a rear axle, or a front
-// axle checked for bump steer); "none" (default) leaves the upright free to
+// axle checked for bump steer); "rack" puts the rod's inner end on the axle's
+// steering rack (rack_and_pinion.h); "none" (default) leaves the upright free to
 // turn about its kingpin (the line from the lower ball joint to the top mount)
 // for a steering plugin, as the App. A double wishbone does.
 //
@@ -44,8 +45,8 @@ struct MacPhersonStrutParams {
   SimTK::Vec3 strut_chassis_m;           ///< strut top mount
   SimTK::Vec3 strut_upright_m;           ///< strut's lower point on the upright (with the top mount: its axis)
   SimTK::Vec3 spindle_m;                 ///< wheel centre
-  std::string tie_rod = "none";          ///< "none" | "chassis"
-  SimTK::Vec3 tierod_chassis_m, tierod_upright_m;  ///< tie rod ends (tie_rod "chassis")
+  std::string tie_rod = "none";          ///< "none" | "chassis" | "rack" (inner end on the axle's rack)
+  SimTK::Vec3 tierod_chassis_m, tierod_upright_m;  ///< tie rod ends (tie_rod "chassis" or "rack": inner at zero rack travel)
   double camber_rad = 0;                 ///< static camber, + top of the wheel outward
   double toe_in_rad = 0;                 ///< static toe, + toe-in
   double spring_stiffness_N_per_m = 0;   ///< along the strut, top mount to strut_upright
@@ -86,6 +87,7 @@ class MacPhersonStrutSuspension : public Suspension {
   double getSuspensionCoordinate(const SimTK::State& s, int side) const override;
   double calcLoopGap(const SimTK::State& s, int side) const override;
   bool isSteerable() const override { return params_[0].tie_rod == "none" && params_[1].tie_rod == "none"; }
+  bool usesRack() const override { return params_[0].tie_rod == "rack"; }
   bool getKinematicCorner(int side, KinematicCorner* k) const override {
     const MacPhersonStrutCorner& c = corners_[side];
     *k = {c.lower_arm, {c.upright.getMobilizedBodyIndex()}, c.upright, c.wheel, c.spring};
