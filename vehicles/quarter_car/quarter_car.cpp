@@ -13,6 +13,9 @@ void QuarterCarParams::validate() const {
   corner.validate("quarter car corner");
   makeRoad(road);
   requireFinite(upper_pivot_offset_m, "quarter car upper_pivot_offset_m");
+  if (upper_pivot_offset_applies_to != "arm" && upper_pivot_offset_applies_to != "chassis")
+    throw Error("quarter car upper_pivot_offset_applies_to: expected arm or chassis, got '" +
+                upper_pivot_offset_applies_to + "'");
   requireNonNegative(gravity_m_per_s2, "quarter car gravity_m_per_s2");
   if (tire.plugin.empty()) throw Error("quarter car tire plugin name is empty");
 }
@@ -57,6 +60,10 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
           .sample("{\"type\": \"flat\"}")
           .number("upper_pivot_offset_m", &P::upper_pivot_offset_m, "m",
                   "s', offset of the upper A-arm's inner pivot along zeta, + up")
+          .string("upper_pivot_offset_applies_to", &P::upper_pivot_offset_applies_to,
+                  "where s' applies: arm (the pivot's two points on the upper arm, arm frame: the arm's outer end "
+                  "drops relative to the hinge) | chassis (the hinge's two points on the chassis: hinge and arm "
+                  "rise together)")
           .boolean("steer_lock", &P::steer_lock, "hold the steer angle at 90 deg (else the knuckle turns freely)")
           .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
           .boolean("spring_free_length_from_ride_height", &P::spring_free_length_from_ride_height,
@@ -67,6 +74,9 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
 QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r, const PluginRegistry* registry) {
   QuarterCarParams p = fields().read(r);
   requirePositive(p.chassis_mass_kg, r.at("chassis_mass_kg"));
+  if (p.upper_pivot_offset_applies_to != "arm" && p.upper_pivot_offset_applies_to != "chassis")
+    throw Error(r.at("upper_pivot_offset_applies_to") + ": expected arm or chassis, got '" +
+                p.upper_pivot_offset_applies_to + "'");
   p.validate();
   return p.spring_free_length_from_ride_height ? p.withRideHeightSpring(registry) : p;
 }
@@ -118,8 +128,14 @@ QuarterCar::QuarterCar(const QuarterCarParams& params, const PluginRegistry& reg
   sc.addBody("chassis", chassis_);
 
   DoubleWishboneParams cp = p_.corner;
-  cp.upper_pivot.child_point_m[2] += p_.upper_pivot_offset_m;  // s' moves the pivot and its axis point together
-  cp.upper_pivot.child_axis_point_m[2] += p_.upper_pivot_offset_m;
+  // s' moves the pivot and its axis point together, on the arm or on the chassis.
+  if (p_.upper_pivot_offset_applies_to == "chassis") {
+    cp.upper_pivot.parent_point_m[2] += p_.upper_pivot_offset_m;
+    cp.upper_pivot.parent_axis_point_m[2] += p_.upper_pivot_offset_m;
+  } else {
+    cp.upper_pivot.child_point_m[2] += p_.upper_pivot_offset_m;
+    cp.upper_pivot.child_axis_point_m[2] += p_.upper_pivot_offset_m;
+  }
   corner_ = buildDoubleWishbone(sc, chassis_, cp, "");
   if (p_.steer_lock)
     SimTK::Constraint::ConstantAngle(chassis_, SimTK::UnitVec3(SimTK::XAxis), corner_.knuckle,
