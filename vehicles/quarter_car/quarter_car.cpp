@@ -13,6 +13,8 @@ void QuarterCarParams::validate() const {
   corner.validate("quarter car corner");
   makeRoad(road);
   requireFinite(upper_pivot_offset_m, "quarter car upper_pivot_offset_m");
+  if (rest_pose != "tabulated" && rest_pose != "lower_arm_level")
+    throw Error("quarter car rest_pose: expected tabulated or lower_arm_level, got '" + rest_pose + "'");
   if (upper_pivot_offset_applies_to != "arm" && upper_pivot_offset_applies_to != "chassis")
     throw Error("quarter car upper_pivot_offset_applies_to: expected arm or chassis, got '" +
                 upper_pivot_offset_applies_to + "'");
@@ -67,13 +69,18 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
           .boolean("steer_lock", &P::steer_lock, "hold the steer angle at 90 deg (else the knuckle turns freely)")
           .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
           .boolean("spring_free_length_from_ride_height", &P::spring_free_length_from_ride_height,
-                   "replace the spring free length by the one that makes the tabulated configuration static");
+                   "replace the spring free length by the one that makes the rest pose static")
+          .string("rest_pose", &P::rest_pose,
+                  "configuration the loop is closed in: tabulated (App. A's body frames) | lower_arm_level (the "
+                  "lower arm's pivot-to-ball line level, the arm held while the loop closes)");
   return t;
 }
 
 QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r, const PluginRegistry* registry) {
   QuarterCarParams p = fields().read(r);
   requirePositive(p.chassis_mass_kg, r.at("chassis_mass_kg"));
+  if (p.rest_pose != "tabulated" && p.rest_pose != "lower_arm_level")
+    throw Error(r.at("rest_pose") + ": expected tabulated or lower_arm_level, got '" + p.rest_pose + "'");
   if (p.upper_pivot_offset_applies_to != "arm" && p.upper_pivot_offset_applies_to != "chassis")
     throw Error(r.at("upper_pivot_offset_applies_to") + ": expected arm or chassis, got '" +
                 p.upper_pivot_offset_applies_to + "'");
@@ -194,8 +201,32 @@ SimTK::State QuarterCar::makeInitialState(bool equilibrium, AssemblyReport* repo
   const auto& ub = p_.corner.upper_ball;
   const double gap = (corner_.upper_arm.findStationLocationInGround(s, ub.parent_point_m) -
                       corner_.knuckle.findStationLocationInGround(s, ub.child_point_m)).norm();
-  assembleLoops(system, s, {chassis_.getMobilizedBodyIndex(), corner_.wheel.getMobilizedBodyIndex()}, bodies, gap,
-                "quarter car", report);
+  std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex(),
+                                                   corner_.wheel.getMobilizedBodyIndex()};
+  const double wheelZ = corner_.wheel.getBodyOriginLocation(s)[2];
+  if (p_.rest_pose == "lower_arm_level") {
+    // Secant on the lower arm angle for a level pivot-to-ball line (zeta difference 0).
+    const auto arm = corner_.lower_arm;
+    auto rise = [&](double q) {
+      arm.setOneQ(s, 0, q);
+      system.realize(s, SimTK::Stage::Position);
+      return arm.findStationLocationInGround(s, p_.corner.lower_ball.parent_point_m)[2] -
+             arm.findStationLocationInGround(s, p_.corner.lower_pivot.child_point_m)[2];
+    };
+    double q0 = 0, q1 = 0.01, f0 = rise(q0), f1 = rise(q1);
+    for (int i = 0; i < 50 && std::abs(f1) > 1e-14; ++i) {
+      const double q2 = q1 - f1 * (q1 - q0) / (f1 - f0);
+      q0 = q1, f0 = f1, q1 = q2, f1 = rise(q1);
+    }
+    if (!(std::abs(f1) <= 1e-12)) throw Error("quarter car rest_pose lower_arm_level: no level lower arm angle found");
+    locked.push_back(arm.getMobilizedBodyIndex());
+  }
+  assembleLoops(system, s, locked, bodies, gap, "quarter car", report);
+  if (p_.rest_pose == "lower_arm_level") {
+    // The chassis slides so the wheel centre is where the tabulated pose put it (the tire's load estimate).
+    chassis_.setOneQ(s, 0, chassis_.getOneQ(s, 0) + wheelZ - corner_.wheel.getBodyOriginLocation(s)[2]);
+    system.realize(s, SimTK::Stage::Position);
+  }
   if (equilibrium) solveStaticEquilibrium(*scene_, s, ineffectiveMobilizers());
   return s;
 }

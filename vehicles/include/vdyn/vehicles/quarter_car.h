@@ -44,6 +44,12 @@ struct QuarterCarParams {
   /// (loop-closed) configuration the static equilibrium: the seed's K = 40e3 N/m
   /// with App. A's 0.344 m free length sags the corner until the linkage locks.
   bool spring_free_length_from_ride_height = false;
+  /// The configuration the loop is closed in (and the ride-height rule makes
+  /// static): "tabulated" (App. A's body frames aligned with the chassis, the
+  /// lower arm's pivot-to-ball line 7.3 deg below level) or "lower_arm_level"
+  /// (the lower arm turned about its pivot until the line from its pivot to its
+  /// ball joint is level, zeta equal, then the loop closed with it held).
+  std::string rest_pose = "tabulated";
 
   void validate() const;
   /// Reads a quarter-car data file (it names the vehicle data file and corner).
