@@ -11,10 +11,12 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <map>
 
 #include "study.h"
 #include "vdyn/analyses/analyses.h"
 #include "vdyn/sensitivity/sensitivity.h"
+#include "vdyn/vehicles/quarter_car.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 using namespace vdyn;
@@ -105,6 +107,24 @@ int main(int argc, char** argv) {
     set.refinement = mixedRefinementFromName(mixed.stringOr("refinement", "uniform"), mixed.at("refinement"));
     set.reference_accuracy = ref.number("accuracy");
     set.reference_perturbation = ref.number("perturbation");
+    // The seed's Table 4.1: sign (and value where known) per symbol.
+    struct SeedEntry { int sign = 0; double value = NAN; };
+    std::map<std::string, SeedEntry> seed;
+    if (vehicle == "quarter_car") {
+      const ParamReader st = data.child("seed_table_4_1");
+      for (auto it = st.json().begin(); it != st.json().end(); ++it) {
+        const ParamReader e = st.child(it.key());
+        SeedEntry se;
+        const double sg = e.number("sign");
+        if (sg != 1 && sg != -1) throw Error(e.at("sign") + ": expected -1 or 1, got " + formatValue(sg));
+        se.sign = int(sg);
+        if (e.has("dpsi_db")) se.value = e.number("dpsi_db");
+        e.requireAllKeysRead();
+        seed[it.key()] = se;
+      }
+    } else {
+      data.has("seed_table_4_1");
+    }
     data.requireAllKeysRead();
     if (vm.count("tolerance")) set.tolerance = vm["tolerance"].as<double>();
     if (vm.count("reference-accuracy")) set.reference_accuracy = vm["reference-accuracy"].as<double>();
@@ -192,6 +212,39 @@ int main(int argc, char** argv) {
       for (double d : r.dpsi_db) std::printf(" %.6g", d);
       std::printf("\n");
     }
+    // The configuration Table 4.1 depends on (docs/table_4_1.md), and the seed's values.
+    std::string configuration;
+    if (vehicle == "quarter_car") {
+      BuiltScene nb = scene.build();
+      const QuarterCar& qc = nb.vehicleAs<QuarterCar>();
+      const QuarterCarParams& qp = qc.params();
+      const std::string derived = analysis.stringOr("derived_data", "nominal");
+      const int dof = qc.degreesOfFreedom(qc.makeInitialState(false));
+      summary["configuration"] = {{"steer_lock", qp.steer_lock},
+                                  {"degrees_of_freedom", dof},
+                                  {"upper_pivot_offset_applies_to", qp.upper_pivot_offset_applies_to},
+                                  {"rest_pose", qp.rest_pose},
+                                  {"derived_data", derived}};
+      configuration = std::string("steer ") + (qp.steer_lock ? "locked" : "free") + " (" + std::to_string(dof) +
+                      " dof), s' on the " + qp.upper_pivot_offset_applies_to + ", rest pose " + qp.rest_pose +
+                      ", spring free length " + (derived == "nominal" ? "held at the nominal design's" : "re-derived per design");
+      const SensitivityResult& best = reference ? *reference : results.front();
+      Json table = Json::array();
+      int matched = 0, known = 0;
+      for (std::size_t i = 0; i < idx.size(); ++i) {
+        const auto f = seed.find(mp[idx[i]].symbol);
+        if (f == seed.end()) continue;
+        const bool ok = (best.dpsi_db[i] < 0 ? -1 : 1) == f->second.sign;
+        ++known;
+        matched += ok;
+        Json row = {{"symbol", mp[idx[i]].symbol}, {"vdyn", best.dpsi_db[i]}, {"seed_sign", f->second.sign},
+                    {"sign_matches", ok}};
+        if (!std::isnan(f->second.value)) row["seed"] = f->second.value;
+        table.push_back(row);
+      }
+      summary["table_4_1"] = {{"method", best.method}, {"rows", table}, {"signs_matched", matched},
+                              {"signs_compared", known}};
+    }
     study::writeJson(out + "/summary.json", summary);
 
     if (!vm.count("no-plots") && reference && results.size() > 1) {
@@ -222,15 +275,25 @@ int main(int argc, char** argv) {
                 vehicle == "quarter_car" ? "quarter car" : "4ws vehicle",
                 vehicle != "quarter_car" ? "" : relaxation ? " (relaxation-length tire)" : " (steady-slip tire)",
                 prob.cost.describe().c_str(), prob.t_end_s, prob.integrator.method.c_str(), prob.integrator.accuracy);
+    if (!configuration.empty()) std::printf("  configuration: %s\n", configuration.c_str());
     std::printf("  psi = %.9g\n", psi);
     std::printf("  %-34s", "d psi / d b");
     for (const auto& r : results) std::printf(" %16s", r.method.c_str());
+    if (!seed.empty()) std::printf(" %16s", "seed (Tab. 4.1)");
     std::printf("\n");
     for (std::size_t i = 0; i < idx.size(); ++i) {
       std::printf("  %-6s %-27s", mp[idx[i]].symbol.substr(0, 6).c_str(), mp[idx[i]].name.substr(0, 27).c_str());
       for (const auto& r : results) std::printf(" %16.9g", r.dpsi_db[i]);
+      const auto f = seed.find(mp[idx[i]].symbol);
+      if (f != seed.end()) {
+        if (std::isnan(f->second.value)) std::printf(" %16s", f->second.sign < 0 ? "< 0" : "> 0");
+        else std::printf(" %16.4g", f->second.value);
+      }
       std::printf("\n");
     }
+    if (summary.contains("table_4_1"))
+      std::printf("  signs as the seed's (%s): %d of %d\n", summary["table_4_1"]["method"].get<std::string>().c_str(),
+                  summary["table_4_1"]["signs_matched"].get<int>(), summary["table_4_1"]["signs_compared"].get<int>());
     std::printf("  %-34s", "max rel. error vs reference");
     for (std::size_t k = 0; k < results.size(); ++k) {
       if (relErrors[k].empty()) std::printf(" %16s", "-");

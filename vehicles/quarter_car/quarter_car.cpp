@@ -13,6 +13,11 @@ void QuarterCarParams::validate() const {
   corner.validate("quarter car corner");
   makeRoad(road);
   requireFinite(upper_pivot_offset_m, "quarter car upper_pivot_offset_m");
+  if (rest_pose != "tabulated" && rest_pose != "lower_arm_level")
+    throw Error("quarter car rest_pose: expected tabulated or lower_arm_level, got '" + rest_pose + "'");
+  if (upper_pivot_offset_applies_to != "arm" && upper_pivot_offset_applies_to != "chassis")
+    throw Error("quarter car upper_pivot_offset_applies_to: expected arm or chassis, got '" +
+                upper_pivot_offset_applies_to + "'");
   requireNonNegative(gravity_m_per_s2, "quarter car gravity_m_per_s2");
   if (tire.plugin.empty()) throw Error("quarter car tire plugin name is empty");
 }
@@ -57,16 +62,28 @@ const FieldTable<QuarterCarParams>& QuarterCarParams::fields() {
           .sample("{\"type\": \"flat\"}")
           .number("upper_pivot_offset_m", &P::upper_pivot_offset_m, "m",
                   "s', offset of the upper A-arm's inner pivot along zeta, + up")
+          .string("upper_pivot_offset_applies_to", &P::upper_pivot_offset_applies_to,
+                  "where s' applies: arm (the pivot's two points on the upper arm, arm frame: the arm's outer end "
+                  "drops relative to the hinge) | chassis (the hinge's two points on the chassis: hinge and arm "
+                  "rise together)")
           .boolean("steer_lock", &P::steer_lock, "hold the steer angle at 90 deg (else the knuckle turns freely)")
           .number("gravity_m_per_s2", &P::gravity_m_per_s2, "m/s^2", "gravity along -z")
           .boolean("spring_free_length_from_ride_height", &P::spring_free_length_from_ride_height,
-                   "replace the spring free length by the one that makes the tabulated configuration static");
+                   "replace the spring free length by the one that makes the rest pose static")
+          .string("rest_pose", &P::rest_pose,
+                  "configuration the loop is closed in: tabulated (App. A's body frames) | lower_arm_level (the "
+                  "lower arm's pivot-to-ball line level, the arm held while the loop closes)");
   return t;
 }
 
 QuarterCarParams QuarterCarParams::fromParams(const ParamReader& r, const PluginRegistry* registry) {
   QuarterCarParams p = fields().read(r);
   requirePositive(p.chassis_mass_kg, r.at("chassis_mass_kg"));
+  if (p.rest_pose != "tabulated" && p.rest_pose != "lower_arm_level")
+    throw Error(r.at("rest_pose") + ": expected tabulated or lower_arm_level, got '" + p.rest_pose + "'");
+  if (p.upper_pivot_offset_applies_to != "arm" && p.upper_pivot_offset_applies_to != "chassis")
+    throw Error(r.at("upper_pivot_offset_applies_to") + ": expected arm or chassis, got '" +
+                p.upper_pivot_offset_applies_to + "'");
   p.validate();
   return p.spring_free_length_from_ride_height ? p.withRideHeightSpring(registry) : p;
 }
@@ -118,8 +135,14 @@ QuarterCar::QuarterCar(const QuarterCarParams& params, const PluginRegistry& reg
   sc.addBody("chassis", chassis_);
 
   DoubleWishboneParams cp = p_.corner;
-  cp.upper_pivot.child_point_m[2] += p_.upper_pivot_offset_m;  // s' moves the pivot and its axis point together
-  cp.upper_pivot.child_axis_point_m[2] += p_.upper_pivot_offset_m;
+  // s' moves the pivot and its axis point together, on the arm or on the chassis.
+  if (p_.upper_pivot_offset_applies_to == "chassis") {
+    cp.upper_pivot.parent_point_m[2] += p_.upper_pivot_offset_m;
+    cp.upper_pivot.parent_axis_point_m[2] += p_.upper_pivot_offset_m;
+  } else {
+    cp.upper_pivot.child_point_m[2] += p_.upper_pivot_offset_m;
+    cp.upper_pivot.child_axis_point_m[2] += p_.upper_pivot_offset_m;
+  }
   corner_ = buildDoubleWishbone(sc, chassis_, cp, "");
   if (p_.steer_lock)
     SimTK::Constraint::ConstantAngle(chassis_, SimTK::UnitVec3(SimTK::XAxis), corner_.knuckle,
@@ -178,8 +201,32 @@ SimTK::State QuarterCar::makeInitialState(bool equilibrium, AssemblyReport* repo
   const auto& ub = p_.corner.upper_ball;
   const double gap = (corner_.upper_arm.findStationLocationInGround(s, ub.parent_point_m) -
                       corner_.knuckle.findStationLocationInGround(s, ub.child_point_m)).norm();
-  assembleLoops(system, s, {chassis_.getMobilizedBodyIndex(), corner_.wheel.getMobilizedBodyIndex()}, bodies, gap,
-                "quarter car", report);
+  std::vector<SimTK::MobilizedBodyIndex> locked = {chassis_.getMobilizedBodyIndex(),
+                                                   corner_.wheel.getMobilizedBodyIndex()};
+  const double wheelZ = corner_.wheel.getBodyOriginLocation(s)[2];
+  if (p_.rest_pose == "lower_arm_level") {
+    // Secant on the lower arm angle for a level pivot-to-ball line (zeta difference 0).
+    const auto arm = corner_.lower_arm;
+    auto rise = [&](double q) {
+      arm.setOneQ(s, 0, q);
+      system.realize(s, SimTK::Stage::Position);
+      return arm.findStationLocationInGround(s, p_.corner.lower_ball.parent_point_m)[2] -
+             arm.findStationLocationInGround(s, p_.corner.lower_pivot.child_point_m)[2];
+    };
+    double q0 = 0, q1 = 0.01, f0 = rise(q0), f1 = rise(q1);
+    for (int i = 0; i < 50 && std::abs(f1) > 1e-14; ++i) {
+      const double q2 = q1 - f1 * (q1 - q0) / (f1 - f0);
+      q0 = q1, f0 = f1, q1 = q2, f1 = rise(q1);
+    }
+    if (!(std::abs(f1) <= 1e-12)) throw Error("quarter car rest_pose lower_arm_level: no level lower arm angle found");
+    locked.push_back(arm.getMobilizedBodyIndex());
+  }
+  assembleLoops(system, s, locked, bodies, gap, "quarter car", report);
+  if (p_.rest_pose == "lower_arm_level") {
+    // The chassis slides so the wheel centre is where the tabulated pose put it (the tire's load estimate).
+    chassis_.setOneQ(s, 0, chassis_.getOneQ(s, 0) + wheelZ - corner_.wheel.getBodyOriginLocation(s)[2]);
+    system.realize(s, SimTK::Stage::Position);
+  }
   if (equilibrium) solveStaticEquilibrium(*scene_, s, ineffectiveMobilizers());
   return s;
 }

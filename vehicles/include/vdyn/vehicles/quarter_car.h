@@ -25,9 +25,16 @@ struct QuarterCarParams {
   /// The tire; its params' radial_stiffness_N_per_m is the seed's design parameter Cz.
   TireChoice tire;
   RoadParams road;
-  /// s': offset along zeta of the upper A-arm's inner pivot point on the arm
-  /// (joint 5 of the quarter car, App. A joint 4), m, + up.
+  /// s': offset along zeta of the upper A-arm's inner pivot (joint 5 of the
+  /// quarter car, App. A joint 4), m, + up; where it applies is
+  /// upper_pivot_offset_applies_to.
   double upper_pivot_offset_m = 0.0;
+  /// "arm": s' moves the joint's two points on the upper arm (child_point_m and
+  /// child_axis_point_m, arm frame) up, which lowers the arm's outer end
+  /// relative to its hinge; "chassis": s' moves the hinge's two points on the
+  /// chassis (parent_point_m and parent_axis_point_m, chassis frame) up, the
+  /// arm rigid, so the hinge axis and the arm rise together (docs/table_4_1.md).
+  std::string upper_pivot_offset_applies_to = "arm";
   /// Hold the steer angle (chassis xi axis to wheel spin axis) at 90 deg; without
   /// it the knuckle turns freely about the kingpin axis.
   bool steer_lock = true;
@@ -37,6 +44,12 @@ struct QuarterCarParams {
   /// (loop-closed) configuration the static equilibrium: the seed's K = 40e3 N/m
   /// with App. A's 0.344 m free length sags the corner until the linkage locks.
   bool spring_free_length_from_ride_height = false;
+  /// The configuration the loop is closed in (and the ride-height rule makes
+  /// static): "tabulated" (App. A's body frames aligned with the chassis, the
+  /// lower arm's pivot-to-ball line 7.3 deg below level) or "lower_arm_level"
+  /// (the lower arm turned about its pivot until the line from its pivot to its
+  /// ball joint is level, zeta equal, then the loop closed with it held).
+  std::string rest_pose = "tabulated";
 
   void validate() const;
   /// Reads a quarter-car data file (it names the vehicle data file and corner).
