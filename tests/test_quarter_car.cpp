@@ -199,6 +199,29 @@ TEST(QuarterCar, AppAFreeLengthHasNoRestPoseInBump) {
   EXPECT_GT(minImb, 53.0);
   EXPECT_LT(minImb, 54.0);
   EXPECT_NEAR(argmin * 180 / M_PI, -35.0, 1.5);
+  // The only rest pose within 86 deg of the tabulated angle lies in rebound near
+  // 84 deg, and it is unstable: the arm's imbalance changes sign from + to - there,
+  // so on either side the spring drives the arm away from it.
+  // (Reached by continuation in 2 deg steps: a jump lifts the tire off the road.)
+  s = car.makeInitialState(false);
+  for (int k = 1; k <= 40; ++k) armImbalance(car, s, q0 + 2 * k * M_PI / 180);
+  double qr = 0;
+  for (int k = 0; k < 12 && qr == 0; ++k) {
+    const double a = q0 + (80 + 0.5 * k) * M_PI / 180, b = a + 0.5 * M_PI / 180;
+    if (armImbalance(car, s, a) > 0 && armImbalance(car, s, b) < 0) qr = a;
+  }
+  ASSERT_NE(qr, 0.0);
+  armImbalance(car, s, qr);
+  SimTK::State reb = s;
+  const auto rr = solveStaticEquilibrium(car.getScene(), reb, car.ineffectiveMobilizers());
+  const double qreb = car.corner().lower_arm.getOneQ(reb, 0);
+  std::printf("rest pose in rebound (unstable): arm %.6f deg, chassis z %.6f m, %d Newton iterations\n",
+              qreb * 180 / M_PI, car.chassis().getOneQ(reb, 0), rr.newton_iterations);
+  EXPECT_LE(rr.force_residual, 1e-6);
+  EXPECT_GT(qreb * 180 / M_PI, 83.0);
+  EXPECT_LT(qreb * 180 / M_PI, 86.0);
+  EXPECT_GT(armImbalance(car, s, qreb - M_PI / 180), 0.0);
+  EXPECT_LT(armImbalance(car, s, qreb + M_PI / 180), 0.0);
   // The full solve: Newton stalls, Levenberg-Marquardt reaches the residual's
   // minimum and the error says there is no equilibrium near this start.
   SimTK::State e = car.makeInitialState(false);
