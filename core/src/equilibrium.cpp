@@ -81,16 +81,16 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
     r.head(nq).cwiseAbs().maxCoeff(&worst);
     return us[worst];
   };
-  auto logIteration = [&](const char* phase, int it, double step, double m0, double m1, const Eigen::VectorXd& x,
+  auto logIteration = [&](bool newton, int it, double step, double m0, double m1, const Eigen::VectorXd& x,
                           const Eigen::VectorXd& r, const Eigen::MatrixXd& J) {
     if (!logEnabled(LogLevel::Debug)) return;
     const Eigen::VectorXd sv = J.jacobiSvd().singularValues();
     std::string xs;
     for (int i = 0; i < nq; ++i) xs += logFormat(" %.6g", x[i]);
     logMessage(LogLevel::Debug,
-               logFormat("equilibrium: %s iteration %d step %g merit %g -> %g, max force %g at u[%d], max qerr %g, "
+               logFormat("equilibrium: %siteration %d %s %g merit %g -> %g, max force %g at u[%d], max qerr %g, "
                          "Jacobian singular values max %g min %g, q:%s",
-                         phase, it, step, m0, m1, r.head(nq).lpNorm<Eigen::Infinity>(), worstEquation(r),
+                         newton ? "" : "Levenberg-Marquardt ", it, newton ? "alpha" : "damping", step, m0, m1, r.head(nq).lpNorm<Eigen::Infinity>(), worstEquation(r),
                          mp ? r.tail(mp).lpNorm<Eigen::Infinity>() : 0.0, sv[0], sv[n - 1], xs.c_str()));
   };
 
@@ -115,7 +115,7 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
       decreased = rn.allFinite() && merit(rn) < m0;
       if (!decreased) alpha *= 0.5;
     }
-    logIteration("Newton", res.newton_iterations, alpha, m0, merit(rn), x, r, J);
+    logIteration(true, res.newton_iterations, alpha, m0, merit(rn), x, r, J);
     if (!decreased) break;  // no descent: the fallback below, or the report
     x = xn;
     r = rn;
@@ -161,7 +161,7 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
         decreased = rn.allFinite() && merit(rn) < m0;
         mu = decreased ? std::max(mu / 3, 1e-15) : mu * 4;
       }
-      logIteration("Levenberg-Marquardt", res.trust_region_iterations, mu, m0, decreased ? merit(rn) : m0, x, r, J);
+      logIteration(false, res.trust_region_iterations, mu, m0, decreased ? merit(rn) : m0, x, r, J);
       if (!decreased) {  // no step reduces the merit: a minimum to round-off
         stationary = true;
         break;
