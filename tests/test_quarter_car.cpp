@@ -147,3 +147,144 @@ TEST(QuarterCar, CostIntegralMatchesQuadratureOfTheRecordedHistory) {
   const double psi = car.getScene().getIntegral(h, s);
   EXPECT_NEAR(psi, q, 1e-5 * psi);
 }
+
+
+namespace {
+// App. A's own spring free length (0.344 m; data key spring_free_length_from_ride_height
+// false), on a flat road. `frictionless`: no tangential tire forces, so a transient's rest
+// pose does not depend on the path (with friction the patch is held where it stopped
+// scrubbing and the run ends about 1 cm from the frictionless rest pose).
+QuarterCarParams appAFreeLength(bool frictionless) {
+  QuarterCarParams p = QuarterCarParams::fromParams(ParamReader::fromFile("quarter_car.json").mergedWith(
+      ParamReader::fromJson(Json{{"spring_free_length_from_ride_height", false}}, "test patch")));
+  p.road.type = "flat";
+  p.road.amplitude_m = 0;
+  if (frictionless)
+    for (const char* k : {"mu_max", "mu_min", "longitudinal_stiffness_N", "cornering_stiffness_N_per_rad"})
+      p.tire.params[k] = 0.0;
+  return p;
+}
+
+// The arm's generalized-force imbalance, N m, with the lower arm held at `q` and
+// everything else in static equilibrium (the arm's row of the residual M udot - f:
+// positive drives the arm to smaller q, into bump).
+double armImbalance(const QuarterCar& car, SimTK::State& s, double q) {
+  const auto arm = car.corner().lower_arm;
+  arm.setOneQ(s, 0, q);
+  const auto eq = solveStaticEquilibrium(car.getScene(), s,
+                                         {car.corner().wheel.getMobilizedBodyIndex(), arm.getMobilizedBodyIndex()});
+  return eq.force_residual_all[arm.getFirstUIndex(s)];
+}
+}  // namespace
+
+TEST(QuarterCar, AppAFreeLengthHasNoRestPoseInBump) {
+  // Why the solver cannot converge here: with the 0.344 m free length no rest
+  // pose exists in bump. Independent of the full solve, hold the lower arm at
+  // each angle from the tabulated one to 70 deg into bump (1 deg steps), solve
+  // the rest, and read the arm's imbalance: it stays above 50 N m, with its
+  // minimum (a fold: the spring's line turns towards the arm pivot and its
+  // moment stops growing) near 35 deg.
+  const QuarterCarParams p = appAFreeLength(false);
+  ASSERT_DOUBLE_EQ(p.corner.spring_free_length_m, 0.344);
+  const QuarterCar car(p);
+  SimTK::State s = car.makeInitialState(false);
+  const double q0 = car.corner().lower_arm.getOneQ(s, 0);
+  double minImb = 1e30, argmin = 0;
+  for (int k = 0; k <= 70; ++k) {
+    const double q = q0 - k * M_PI / 180, imb = armImbalance(car, s, q);
+    if (imb < minImb) minImb = imb, argmin = q;
+  }
+  std::printf("free length 0.344 m: the arm's smallest imbalance %.4f N m at %.2f deg (tabulated %.2f deg)\n", minImb,
+              argmin * 180 / M_PI, q0 * 180 / M_PI);
+  EXPECT_GT(minImb, 53.0);
+  EXPECT_LT(minImb, 54.0);
+  EXPECT_NEAR(argmin * 180 / M_PI, -35.0, 1.5);
+  // The only rest pose within 86 deg of the tabulated angle lies in rebound near
+  // 84 deg, and it is unstable: the arm's imbalance changes sign from + to - there,
+  // so on either side the spring drives the arm away from it.
+  // (Reached by continuation in 2 deg steps: a jump lifts the tire off the road.)
+  s = car.makeInitialState(false);
+  for (int k = 1; k <= 40; ++k) armImbalance(car, s, q0 + 2 * k * M_PI / 180);
+  double qr = 0;
+  for (int k = 0; k < 12 && qr == 0; ++k) {
+    const double a = q0 + (80 + 0.5 * k) * M_PI / 180, b = a + 0.5 * M_PI / 180;
+    if (armImbalance(car, s, a) > 0 && armImbalance(car, s, b) < 0) qr = a;
+  }
+  ASSERT_NE(qr, 0.0);
+  armImbalance(car, s, qr);
+  SimTK::State reb = s;
+  const auto rr = solveStaticEquilibrium(car.getScene(), reb, car.ineffectiveMobilizers());
+  const double qreb = car.corner().lower_arm.getOneQ(reb, 0);
+  std::printf("rest pose in rebound (unstable): arm %.6f deg, chassis z %.6f m, %d Newton iterations\n",
+              qreb * 180 / M_PI, car.chassis().getOneQ(reb, 0), rr.newton_iterations);
+  EXPECT_LE(rr.force_residual, 1e-6);
+  EXPECT_GT(qreb * 180 / M_PI, 83.0);
+  EXPECT_LT(qreb * 180 / M_PI, 86.0);
+  EXPECT_GT(armImbalance(car, s, qreb - M_PI / 180), 0.0);
+  EXPECT_LT(armImbalance(car, s, qreb + M_PI / 180), 0.0);
+  // The full solve: Newton stalls, Levenberg-Marquardt reaches the residual's
+  // minimum and the error says there is no equilibrium near this start.
+  SimTK::State e = car.makeInitialState(false);
+  try {
+    solveStaticEquilibrium(car.getScene(), e, car.ineffectiveMobilizers());
+    ADD_FAILURE() << "converged where no rest pose exists";
+  } catch (const Error& x) {
+    const std::string m = x.what();
+    std::printf("%s\n", m.c_str());
+    EXPECT_NE(m.find("50 Newton and "), std::string::npos);
+    EXPECT_NE(m.find("the residual has a local minimum here"), std::string::npos);
+    EXPECT_NE(m.find("no static equilibrium near this start"), std::string::npos);
+  }
+}
+
+TEST(QuarterCar, DeepBumpRestPoseMatchesADampedTransient) {
+  // Free length 0.360 m (1.6 cm above App. A's, 0.5 cm past the fold at about
+  // 0.355 m where the bump rest pose appears): the rest pose is deep in bump,
+  // near the independent corner model's (13.4 cm lower, arm ~25 deg). The
+  // static equilibrium and the scene's own dynamics (the real damper,
+  // frictionless tire, from the tabulated pose, 10 s) agree to 1e-8.
+  QuarterCarParams p = appAFreeLength(true);
+  p.corner.spring_free_length_m = 0.360;
+  const QuarterCar car(p);
+  const auto arm = car.corner().lower_arm;
+  const Scene& sc = car.getScene();
+  const SimTK::State tab = car.makeInitialState(false);
+  SimTK::State e = tab;
+  const auto r = solveStaticEquilibrium(sc, e, car.ineffectiveMobilizers());
+  EXPECT_EQ(r.trust_region_iterations, 0);  // Newton alone
+  EXPECT_LE(r.force_residual, 1e-6);
+  sc.getSystem().realize(e, SimTK::Stage::Acceleration);
+  const double W = car.totalMass() * car.params().gravity_m_per_s2;
+  SimTK::State s = tab;
+  SimulationSettings sim;
+  sim.t_end_s = 10.0;
+  sim.integrator.accuracy = 1e-10;
+  simulate(sc, s, sim);
+  std::printf("rest pose (free length 0.360 m): chassis z %.10f m (tabulated %.6f, %.4f m lower), lower arm %.10f rad "
+              "(%.3f deg), tire load %.6f N (weight %.6f N), %d Newton iterations; transient at 10 s: z %.10f, arm "
+              "%.10f, |u| %.2e\n",
+              car.chassis().getOneQ(e, 0), car.chassis().getOneQ(tab, 0),
+              car.chassis().getOneQ(tab, 0) - car.chassis().getOneQ(e, 0), arm.getOneQ(e, 0),
+              arm.getOneQ(e, 0) * 180 / M_PI, sc.evalOutput("tire.Fz_N", e), W, r.newton_iterations,
+              car.chassis().getOneQ(s, 0), arm.getOneQ(s, 0), s.getU().normInf());
+  EXPECT_NEAR(sc.evalOutput("tire.Fz_N", e), W, 1e-6);
+  EXPECT_NEAR(car.chassis().getOneQ(s, 0), car.chassis().getOneQ(e, 0), 1e-8);
+  EXPECT_NEAR(arm.getOneQ(s, 0), arm.getOneQ(e, 0), 1e-8);
+  EXPECT_GT(car.chassis().getOneQ(tab, 0) - car.chassis().getOneQ(e, 0), 0.13);
+  EXPECT_LT(s.getU().normInf(), 1e-6);
+
+  // The fallback alone: Newton cut to 3 iterations, Levenberg-Marquardt finishes
+  // to the tolerances at the same pose.
+  StaticEquilibriumOptions opt;
+  opt.max_iterations = 3;
+  SimTK::State f = tab;
+  const auto rf = solveStaticEquilibrium(sc, f, car.ineffectiveMobilizers(), opt);
+  std::printf("Newton cut to 3 iterations: %d Levenberg-Marquardt iterations, residual %.3e N, arm %.12f\n",
+              rf.trust_region_iterations, rf.force_residual, arm.getOneQ(f, 0));
+  EXPECT_EQ(rf.newton_iterations, 3);
+  EXPECT_GT(rf.trust_region_iterations, 0);
+  EXPECT_LE(rf.force_residual, 1e-6);
+  EXPECT_LE(rf.constraint_error, 1e-12);
+  EXPECT_NEAR(car.chassis().getOneQ(f, 0), car.chassis().getOneQ(e, 0), 1e-9);
+  EXPECT_NEAR(arm.getOneQ(f, 0), arm.getOneQ(e, 0), 1e-9);
+}

@@ -65,13 +65,7 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
            (mp == 0 || r.tail(mp).lpNorm<Eigen::Infinity>() <= opt.constraint_tolerance);
   };
 
-  Eigen::VectorXd x(n);
-  for (int i = 0; i < nq; ++i) x[i] = se.getQ()[qs[i]];
-  x.tail(mp).setZero();
-  Eigen::VectorXd r = residual(x);
-  StaticEquilibriumResult res;
-  for (res.iterations = 0; !converged(r); ++res.iterations) {
-    if (res.iterations == opt.max_iterations) break;
+  auto jacobian = [&](const Eigen::VectorXd& x, const Eigen::VectorXd& r) {
     Eigen::MatrixXd J(n, n);
     for (int j = 0; j < n; ++j) {
       const double typical = j < nq ? 1.0 : 1e3;  // rad or m for q; N for lambda
@@ -80,6 +74,36 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
       xp[j] += h;
       J.col(j) = (residual(xp) - r) / h;
     }
+    return J;
+  };
+  auto worstEquation = [&](const Eigen::VectorXd& r) {
+    Eigen::Index worst;
+    r.head(nq).cwiseAbs().maxCoeff(&worst);
+    return us[worst];
+  };
+  auto logIteration = [&](bool newton, int it, double step, double m0, double m1, const Eigen::VectorXd& x,
+                          const Eigen::VectorXd& r, const Eigen::MatrixXd& J) {
+    if (!logEnabled(LogLevel::Debug)) return;
+    const Eigen::VectorXd sv = J.jacobiSvd().singularValues();
+    std::string xs;
+    for (int i = 0; i < nq; ++i) xs += logFormat(" %.6g", x[i]);
+    logMessage(LogLevel::Debug,
+               logFormat("equilibrium: %siteration %d %s %g merit %g -> %g, max force %g at u[%d], max qerr %g, "
+                         "Jacobian singular values max %g min %g, q:%s",
+                         newton ? "" : "Levenberg-Marquardt ", it, newton ? "alpha" : "damping", step, m0, m1, r.head(nq).lpNorm<Eigen::Infinity>(), worstEquation(r),
+                         mp ? r.tail(mp).lpNorm<Eigen::Infinity>() : 0.0, sv[0], sv[n - 1], xs.c_str()));
+  };
+
+  Eigen::VectorXd x(n);
+  for (int i = 0; i < nq; ++i) x[i] = se.getQ()[qs[i]];
+  x.tail(mp).setZero();
+  Eigen::VectorXd r = residual(x);
+  StaticEquilibriumResult res;
+  // 1. Newton-Raphson with a backtracking line search: the first try, and the
+  // whole solve wherever it converges (its results are kept bit for bit).
+  for (res.newton_iterations = 0; !converged(r); ++res.newton_iterations) {
+    if (res.newton_iterations == opt.max_iterations) break;
+    const Eigen::MatrixXd J = jacobian(x, r);
     const Eigen::VectorXd dx = J.fullPivLu().solve(-r);
     double alpha = 1.0;
     const double m0 = merit(r);
@@ -91,24 +115,81 @@ StaticEquilibriumResult solveStaticEquilibrium(const Scene& scene, SimTK::State&
       decreased = rn.allFinite() && merit(rn) < m0;
       if (!decreased) alpha *= 0.5;
     }
-    if (logEnabled(LogLevel::Debug))
-      logMessage(LogLevel::Debug, logFormat("equilibrium: iteration %d alpha %g merit %g -> %g", res.iterations,
-                                            alpha, m0, merit(rn)));
-    if (!decreased) break;  // no descent: report below
+    logIteration(true, res.newton_iterations, alpha, m0, merit(rn), x, r, J);
+    if (!decreased) break;  // no descent: the fallback below, or the report
     x = xn;
     r = rn;
   }
+  // 2. Fallback: Levenberg-Marquardt on the weighted residual w = (force rows,
+  // constraint_weight * constraint rows), whose half square is the line search's
+  // merit. Chosen over a pseudo-transient (damped dynamics) because it needs no
+  // mass matrix or time step, works on the same residual and Jacobian, and
+  // where Newton fails at a fold (a stationary point of the merit with a
+  // singular Jacobian, as the quarter car with App. A's 0.344 m spring, which
+  // has no rest pose in bump) it stops at that minimum and can say so, while a
+  // damped transient of a model without a rest pose runs away through the
+  // linkage's toggle. Near a root the damping falls geometrically and the
+  // steps become Newton steps, which polish the solution to the tolerances.
+  bool stationary = false;
+  double sigmaMin = 0;
+  if (!converged(r) && r.allFinite()) {
+    Eigen::VectorXd w = Eigen::VectorXd::Ones(n);
+    w.tail(mp).setConstant(opt.constraint_weight);
+    double mu = -1;
+    for (res.trust_region_iterations = 0; !converged(r); ++res.trust_region_iterations) {
+      if (res.trust_region_iterations == opt.trust_region_iterations) break;
+      const Eigen::MatrixXd J = jacobian(x, r);
+      const Eigen::MatrixXd Jw = w.asDiagonal() * J;
+      const Eigen::VectorXd rw = w.cwiseProduct(r);
+      const Eigen::MatrixXd A = Jw.transpose() * Jw;
+      const Eigen::VectorXd g = Jw.transpose() * rw;
+      const Eigen::VectorXd d = A.diagonal().cwiseMax(1e-300);  // Marquardt's scaling
+      if (mu < 0) mu = opt.trust_region_initial_damping;
+      // A stationary point of the merit that is not a root: no equilibrium near here.
+      if (g.norm() <= opt.stationary_tolerance * Jw.norm() * rw.norm()) {
+        stationary = true;
+        break;
+      }
+      const double m0 = merit(r);
+      bool decreased = false;
+      Eigen::VectorXd xn, rn;
+      while (!decreased && mu < 1e20) {
+        Eigen::MatrixXd Am = A;
+        Am.diagonal() += mu * d;
+        xn = x + Am.ldlt().solve(-g);
+        rn = residual(xn);
+        decreased = rn.allFinite() && merit(rn) < m0;
+        mu = decreased ? std::max(mu / 3, 1e-15) : mu * 4;
+      }
+      logIteration(false, res.trust_region_iterations, mu, m0, decreased ? merit(rn) : m0, x, r, J);
+      if (!decreased) {  // no step reduces the merit: a minimum to round-off
+        stationary = true;
+        break;
+      }
+      x = xn;
+      r = rn;
+    }
+    if (!converged(r)) sigmaMin = jacobian(x, r).jacobiSvd().singularValues()[n - 1];
+  }
+  res.iterations = res.newton_iterations + res.trust_region_iterations;
   r = residual(x);
   res.force_residual = r.head(nq).lpNorm<Eigen::Infinity>();
   res.constraint_error = mp ? r.tail(mp).lpNorm<Eigen::Infinity>() : 0.0;
   if (!converged(r)) {
-    Eigen::Index worst;
-    r.head(nq).cwiseAbs().maxCoeff(&worst);
-    throw Error("static equilibrium did not converge: " + std::to_string(res.iterations) +
-                " iterations, max force residual " + formatValue(res.force_residual) + " (tolerance " +
-                formatValue(opt.force_tolerance) + ", worst in generalized speed u[" + std::to_string(us[worst]) +
-                "]), max constraint error " + formatValue(res.constraint_error) + " (tolerance " +
-                formatValue(opt.constraint_tolerance) + ")");
+    std::string pose;
+    for (int i = 0; i < nq; ++i) pose += (i ? ", q[" : "q[") + std::to_string(qs[i]) + "] " + formatValue(x[i]);
+    throw Error("static equilibrium did not converge: " + std::to_string(res.newton_iterations) +
+                " Newton and " + std::to_string(res.trust_region_iterations) +
+                " Levenberg-Marquardt iterations, max force residual " + formatValue(res.force_residual) +
+                " (tolerance " + formatValue(opt.force_tolerance) + ", worst in generalized speed u[" +
+                std::to_string(worstEquation(r)) + "]), max constraint error " + formatValue(res.constraint_error) +
+                " (tolerance " + formatValue(opt.constraint_tolerance) + ")" +
+                (stationary ? "; the residual has a local minimum here (smallest singular value of the Jacobian " +
+                                  formatValue(sigmaMin) +
+                                  "): no static equilibrium near this start (past a fold the model may have no "
+                                  "rest pose)"
+                            : "") +
+                " at " + pose + " (Euler angles)");
   }
   res.multipliers = lambda;
   res.force_residual_all = residualForce;

@@ -6,7 +6,10 @@
 // and the multipliers lambda of the position constraints; equations are the
 // force residual  f - M udot - G^T lambda  at udot = 0 (Simbody's inverse
 // dynamics) and the position-constraint errors Psi(q) = 0. Newton-Raphson with
-// a finite-difference Jacobian and a backtracking line search.
+// a finite-difference Jacobian and a backtracking line search; where it fails,
+// Levenberg-Marquardt on the weighted residual (globalised: every step lowers
+// the merit), which stops at a minimum of the residual that is not a root and
+// says so (no equilibrium near the start, e.g. past a fold).
 #include <vector>
 
 #include "vdyn/core/scene.h"
@@ -19,13 +22,23 @@ struct StaticEquilibriumOptions {
   double force_tolerance = 1e-6;
   /// Convergence on the position-constraint errors, m (or rad).
   double constraint_tolerance = 1e-12;
+  /// Newton iterations (the first try), >= 0.
   int max_iterations = 50;
-  /// Weight of constraint rows in the line-search merit, N/m.
+  /// Weight of constraint rows in the merit (line search and Levenberg-Marquardt), N/m.
   double constraint_weight = 1e6;
+  /// Levenberg-Marquardt iterations after Newton fails; 0 = no fallback.
+  int trust_region_iterations = 500;
+  /// Initial Levenberg-Marquardt damping, relative to diag(J^T J) (dimensionless).
+  double trust_region_initial_damping = 1e-3;
+  /// A point is a stationary point of the merit (not a root) when
+  /// |J^T r| <= this * |J| |r| (weighted rows; dimensionless).
+  double stationary_tolerance = 1e-10;
 };
 
 struct StaticEquilibriumResult {
-  int iterations = 0;
+  int iterations = 0;             ///< Newton plus Levenberg-Marquardt iterations
+  int newton_iterations = 0;      ///< of the first try
+  int trust_region_iterations = 0;  ///< of the Levenberg-Marquardt fallback (0 if Newton converged)
   double force_residual = 0;     ///< max |generalized-force residual| at the solution
   double constraint_error = 0;   ///< max |qerr| at the solution
   SimTK::Vector multipliers;     ///< lambda of the position constraints
