@@ -165,13 +165,11 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
   SimulationSettings sim;
   sim.report_interval_s = sample;
   sim.integrator = integrator;
-  // Segments between the restart times (and the release of the speed hold).
+  // The restarts are simulate()'s (SimulationSettings::restart_times_s); the
+  // run is split only where the speed hold is released.
+  sim.restart_times_s = restarts;
   std::vector<double> ends;
-  for (double r : restarts)
-    if (r > 0 && r < t_end) ends.push_back(r);
   if (coastFrom > 0 && coastFrom < t_end) ends.push_back(coastFrom);
-  std::sort(ends.begin(), ends.end());
-  ends.erase(std::unique(ends.begin(), ends.end()), ends.end());
   ends.push_back(t_end);
   if (coastFrom <= 0) v.speed->setEnabled(s, false);
   RunSummary run;
@@ -186,8 +184,8 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
                     formatSig(beta * 180 / SimTK::Pi, 3) + " deg beyond " + formatSig(spinLimit * 180 / SimTK::Pi, 3) +
                     " deg)");
     });
-    // The integrator may stop a rounding short of te; the next segment must
-    // start at the restart time itself (its command from the right).
+    // The integrator may stop a rounding short of te; the next segment
+    // starts at te itself.
     s.setTime(te);
     const RunSummary prev = run;
     run = seg;
