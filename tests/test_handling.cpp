@@ -58,6 +58,12 @@ TEST(Iso4138, LinearTireBicycleUndersteerGradientIsTheClosedForm) {
   EXPECT_NEAR(r.understeer_gradient_linear_rad_per_m_s2, K, 1e-3 * std::abs(K));
   // The path radius is the one asked for: U / r = R.
   for (const auto& p : r.points) EXPECT_NEAR(p.path_radius_m, 100.0, 1e-8);
+  // Side slip of the c.m. (6.1)-(6.9): beta = b / R - M a a_y / (l C_r), so
+  // d beta / d a_y = -M a / (l C_r).
+  const double dbeta = -M * a / (l * C);
+  std::printf("side-slip gradient %.6e rad/(m/s^2) (closed form %.6e)\n", r.side_slip_gradient_linear_rad_per_m_s2,
+              dbeta);
+  EXPECT_NEAR(r.side_slip_gradient_linear_rad_per_m_s2, dbeta, 1e-3 * std::abs(dbeta));
 }
 
 TEST(Iso4138, LongTransientEndsOnTheConstantRadiusSteadyState) {

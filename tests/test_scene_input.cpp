@@ -290,3 +290,33 @@ TEST(Messages, OnePathRuleForASweepsScene) {
   writeText(d + "/sweeps/mine.json", R"({"based_on": "scenes/ch3_steady_state.json"})");
   EXPECT_EQ(WEXITSTATUS(std::system(cmd.c_str())), 0) << readText(d + "/e.txt");
 }
+
+// `vdyn list outputs SCENE` and `vdyn list attachments SCENE` print what the
+// built scene provides: every output with its unit and stage (the recorded
+// ones marked), every attachment with its bindings; without a scene, a named
+// error.
+TEST(ListScene, OutputsAndAttachmentsOfABuiltScene) {
+  const std::string d = freshDir("list_scene");
+  const std::string scene = std::string(VDYN_DATA_DIR) + "/scenes/ch3_transient.json";
+  const Ran o = runVdyn("list outputs '" + scene + "'", d);
+  ASSERT_EQ(o.rc, 0) << o.err;
+  EXPECT_NE(o.out.find("* chassis.yaw_rate_rad_s"), std::string::npos) << o.out;
+  auto lineOf = [](const std::string& text, const std::string& key) {
+    const std::size_t i = text.find(key);
+    if (i == std::string::npos) return std::string();
+    const std::size_t b = text.rfind('\n', i), e = text.find('\n', i);
+    return text.substr(b == std::string::npos ? 0 : b + 1, e - (b == std::string::npos ? 0 : b + 1));
+  };
+  const std::string an = lineOf(o.out, "chassis.path_normal_accel_m_s2");
+  EXPECT_NE(an.find("m/s^2"), std::string::npos) << an;
+  EXPECT_NE(an.find("Acceleration"), std::string::npos) << an;
+  EXPECT_NE(o.out.find("tire_rf.Fz_N"), std::string::npos) << o.out;
+  EXPECT_NE(o.out.find("speed_hold.force_N"), std::string::npos) << o.out;
+  const Ran a = runVdyn("list attachments '" + scene + "'", d);
+  ASSERT_EQ(a.rc, 0) << a.err;
+  EXPECT_NE(a.out.find("front_axle       chassis = chassis, knuckles = rf.knuckle,lf.knuckle"), std::string::npos)
+      << a.out;
+  const Ran e = runVdyn("list outputs", d);
+  EXPECT_EQ(e.rc, 1);
+  EXPECT_NE(e.err.find("vdyn list outputs SCENE: no scene file given"), std::string::npos) << e.err;
+}

@@ -223,3 +223,33 @@ TEST(SteadyState, RelaxationTireLeavesTheSteadyTurnUnchanged) {
   EXPECT_NEAR(c.kinematics.tan_alpha, tanAlpha, 1e-9);
   EXPECT_GT(std::abs(tanAlpha), 1e-3);  // the tire is slipping: the check is not trivial
 }
+
+// The chassis acceleration outputs in App. A's steady 4 deg / 1 deg turn at
+// 10 m/s, from Simbody's forward dynamics at the steady state, against steady
+// circular motion's kinematics from the velocities alone (a = omega x v, omega
+// the chassis' angular velocity): the path-normal acceleration is r |v_h|, the
+// tangential one 0, the chassis-frame components those of omega x v.
+TEST(SteadyState, ChassisAccelerationOutputsAreSteadyCircularMotions) {
+  auto car = std::make_unique<WheeledVehicle>(WheeledVehicleParams::fromFile("appendix_a.json"));
+  car->addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(4.0 * kDeg));
+  car->addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(1.0 * kDeg));
+  car->updScene().addPlugin(std::make_unique<SpeedHoldPlugin>("speed_hold", "chassis", 10.0));
+  const Scene& sc = car->getScene();
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", {"rf.wheel", "lf.wheel", "rr.wheel", "lr.wheel"}, 0.0));
+  SimTK::State s = solver.solve(car->makeInitialState(10.0)).state;
+  sc.getSystem().realize(s, SimTK::Stage::Velocity);
+  const SimTK::MobilizedBody& ch = car->chassis();
+  const SimTK::Vec3 v = ch.getBodyOriginVelocity(s), w = ch.getBodyAngularVelocity(s);
+  const SimTK::Vec3 a = w % v;  // steady circular motion of the c.m.
+  const SimTK::Vec3 a_B = ~ch.getBodyRotation(s) * a;
+  const double vh = std::hypot(v[0], v[1]);
+  const double r = sc.evalOutput("chassis.yaw_rate_rad_s", s);
+  EXPECT_NEAR(sc.evalOutput("chassis.path_normal_accel_m_s2", s), r * vh, 1e-8);
+  EXPECT_NEAR(sc.evalOutput("chassis.path_tangential_accel_m_s2", s), 0.0, 1e-8);
+  EXPECT_NEAR(sc.evalOutput("chassis.lateral_accel_m_s2", s), a_B[1], 1e-8);
+  EXPECT_NEAR(sc.evalOutput("chassis.longitudinal_accel_m_s2", s), a_B[0], 1e-8);
+  EXPECT_GT(r * vh, 1.0);  // 2.42 m/s^2: the check is not trivial
+  std::printf("steady 10 m/s: a_n %.9f m/s^2 (r |v_h| %.9f), chassis-frame a_y %.9f, a_x %.3e\n",
+              sc.evalOutput("chassis.path_normal_accel_m_s2", s), r * vh, sc.evalOutput("chassis.lateral_accel_m_s2", s),
+              sc.evalOutput("chassis.longitudinal_accel_m_s2", s));
+}

@@ -1,11 +1,15 @@
 // vdyn list [NAME]: every registered name by kind, with its keys, units,
 // defaults and one-line meaning (the field tables the loaders read with). NAME
 // is a kind, a choice family or a type name (every kind or family that has a
-// type of that name is printed).
+// type of that name is printed). `vdyn list outputs SCENE` and `vdyn list
+// attachments SCENE` build the scene and print what its vehicle and plugins
+// provide: every output with its unit and stage, every attachment with its
+// bindings.
 #include <algorithm>
 #include <cstdio>
 
 #include "command.h"
+#include "vdyn/core/scene_file.h"
 
 namespace vdyn::cli {
 
@@ -15,11 +19,42 @@ int listCommand(const std::vector<std::string>& args) {
   opts.add_options()("kind", po::value<std::string>(),
                      "only this kind (vehicle, force_element, constraint, controller, analysis), choice family "
                      "(steering_command, rear_steer_strategy, sensitivity_method, ...) or type name (fourws, gim, "
-                     "antiroll_bar, ...)");
+                     "antiroll_bar, ...); or outputs | attachments with a SCENE")(
+      "scene", po::value<std::string>(), "with outputs | attachments: the scene file whose built scene is listed");
   addCommonOptions(opts);
   po::variables_map vm;
-  if (!parseArgs(command("list"), args, opts, {"kind"}, vm)) return 0;
-  const PluginRegistry& registry = registryWithPlugins(vm);
+  if (!parseArgs(command("list"), args, opts, {"kind", "scene"}, vm)) return 0;
+  PluginRegistry& registry = registryWithPlugins(vm);
+  const std::string what = vm.count("kind") ? vm["kind"].as<std::string>() : "";
+  if (what == "outputs" || what == "attachments") {
+    if (!vm.count("scene")) throw Error("vdyn list " + what + " SCENE: no scene file given");
+    const SceneDescription d = SceneDescription::fromFile(vm["scene"].as<std::string>(), registry);
+    const BuiltScene built = d.build();
+    const Scene& sc = built.scene();
+    if (what == "outputs") {
+      std::printf("outputs of scene '%s' (%s; * recorded by its \"outputs\"):\n", built.name.c_str(), d.path().c_str());
+      std::size_t w = 4;
+      for (const auto& n : sc.getOutputNames()) w = std::max(w, n.size());
+      for (const auto& n : sc.getOutputNames()) {
+        const Output& o = sc.getOutput(n);
+        const bool rec = std::find(built.outputs.begin(), built.outputs.end(), n) != built.outputs.end();
+        std::printf("  %c %-*s  %-8s %s\n", rec ? '*' : ' ', int(w), n.c_str(), o.unit.empty() ? "1" : o.unit.c_str(),
+                    SimTK::Stage(o.stage).getName().c_str());
+      }
+    } else {
+      std::printf("attachments of scene '%s' (%s): a plugin's \"attach\" names one; its bindings:\n",
+                  built.name.c_str(), d.path().c_str());
+      for (const auto& a : built.vehicle->getAttachmentNames()) {
+        std::string b;
+        for (const auto& [key, value] : built.vehicle->getAttachment(a)) b += (b.empty() ? "" : ", ") + key + " = " + value;
+        std::printf("  %-16s %s\n", a.c_str(), b.c_str());
+      }
+    }
+    return 0;
+  }
+  if (vm.count("scene"))
+    throw Error("vdyn list: a second argument ('" + vm["scene"].as<std::string>() +
+                "') is only for vdyn list outputs | attachments SCENE");
   auto printType = [](const std::string& type, const TypeInfo& info) {
     std::printf("  %s%s%s\n", type.c_str(), info.summary.empty() ? "" : " -- ", info.summary.c_str());
     int kw = 4, dw = 7;

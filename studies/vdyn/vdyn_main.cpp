@@ -23,7 +23,7 @@ const std::vector<Command>& commands() {
        &runCommand},
       {"check", "check SCENE [--set key.path=value ...] [--plugin PATH ...]",
        "validate a scene file without running it; prints every error found", &checkCommand},
-      {"list", "list [NAME] [--plugin PATH ...]",
+      {"list", "list [NAME] [--plugin PATH ...]; list outputs|attachments SCENE",
        "every registered vehicle, plugin and analysis with its keys, units, defaults and meaning", &listCommand},
       {"sweep", "sweep SWEEP [--threads N] [--out DIR] [--fresh] [--retry-failed] [--plugin PATH ...]; "
                 "mpirun -n N vdyn sweep SWEEP --mpi",

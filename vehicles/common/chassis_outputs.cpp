@@ -46,6 +46,25 @@ void addChassisOutputs(Scene& sc, const SimTK::MobilizedBody& chassis) {
     const Vec3 v = v_B(b, s);
     return std::atan2(v[1], v[0]);
   });
+  // Acceleration of the chassis origin (its c.m.), gravity not included: in
+  // the chassis frame (x forward, y left), and along the path (the horizontal
+  // acceleration's component along the horizontal velocity, and normal to it,
+  // + to the left of the direction of travel: U r in a steady left turn).
+  auto a_B = [](const MB& b, const SimTK::State& s) { return ~b.getBodyRotation(s) * b.getBodyOriginAcceleration(s); };
+  add("chassis.longitudinal_accel_m_s2", "m/s^2", Stage::Acceleration,
+      [a_B](const MB& b, const SimTK::State& s) { return a_B(b, s)[0]; });
+  add("chassis.lateral_accel_m_s2", "m/s^2", Stage::Acceleration,
+      [a_B](const MB& b, const SimTK::State& s) { return a_B(b, s)[1]; });
+  auto path = [](const MB& b, const SimTK::State& s) {
+    const Vec3 v = b.getBodyOriginVelocity(s), a = b.getBodyOriginAcceleration(s);
+    const double vh = std::hypot(v[0], v[1]);
+    if (!(vh > 1e-9)) return SimTK::Vec2(0, 0);  // at rest: no direction of travel
+    return SimTK::Vec2((v[0] * a[0] + v[1] * a[1]) / vh, (v[0] * a[1] - v[1] * a[0]) / vh);
+  };
+  add("chassis.path_tangential_accel_m_s2", "m/s^2", Stage::Acceleration,
+      [path](const MB& b, const SimTK::State& s) { return path(b, s)[0]; });
+  add("chassis.path_normal_accel_m_s2", "m/s^2", Stage::Acceleration,
+      [path](const MB& b, const SimTK::State& s) { return path(b, s)[1]; });
 }
 
 }  // namespace vdyn

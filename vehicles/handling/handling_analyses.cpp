@@ -76,12 +76,14 @@ class ConstantRadiusAnalysis : public Analysis {
     Table t;
     t.columns = {"speed_m_s", "lateral_accel_m_s2", "front_deg", "rear_deg", "side_slip_deg", "roll_deg",
                  "yaw_rate_rad_s", "understeer_gradient_deg_per_m_s2", "delta_minus_l_over_R_deg", "stable",
-                 "least_damped_re_per_s", "speed_hold_force_N"};
+                 "least_damped_re_per_s", "speed_hold_force_N", "roll_gradient_deg_per_m_s2",
+                 "side_slip_gradient_deg_per_m_s2"};
     for (const auto& p : r.points)
       t.rows.push_back({p.speed_m_s, p.lateral_accel_m_s2, p.front_rad / kDeg, p.rear_rad / kDeg, p.side_slip_rad / kDeg,
                         p.roll_rad / kDeg, p.yaw_rate_rad_s, p.understeer_gradient_rad_per_m_s2 / kDeg,
                         (p.front_rad - r.wheelbase_m / r.radius_m) / kDeg, double(p.stable), p.least_damped.real(),
-                        p.speed_hold_force_N});
+                        p.speed_hold_force_N, p.roll_gradient_rad_per_m_s2 / kDeg,
+                        p.side_slip_gradient_rad_per_m_s2 / kDeg});
     res.tables.push_back({"iso4138", t});
     res.summary = {{"vehicle", b->vehicle.name},
                    {"plugins", b->describePlugins()},
@@ -91,6 +93,8 @@ class ConstantRadiusAnalysis : public Analysis {
                    {"limit_speed_m_s", r.limit_speed_m_s},
                    {"limit_lateral_accel_m_s2", r.limit_lateral_accel_m_s2},
                    {"understeer_gradient_linear_deg_per_m_s2", r.understeer_gradient_linear_rad_per_m_s2 / kDeg},
+                   {"roll_gradient_linear_deg_per_m_s2", r.roll_gradient_linear_rad_per_m_s2 / kDeg},
+                   {"side_slip_gradient_linear_deg_per_m_s2", r.side_slip_gradient_linear_rad_per_m_s2 / kDeg},
                    {"stability_lost_speed_m_s", nullIfNan(r.stability_lost_speed_m_s)},
                    {"stability_lost_lateral_accel_m_s2", nullIfNan(r.stability_lost_lateral_accel_m_s2)},
                    {"solve_wall_time_s", r.solve_wall_time_s},

@@ -200,36 +200,41 @@ ConstantRadiusResult runConstantRadius(const HandlingVehicle& v, const ConstantR
     out.solve_wall_time_s += std::chrono::duration<double>(clock::now() - ta).count();
   }
 
-  // Understeer gradient: three-point differences of delta_f(a_y) along the sweep.
+  // Gradients along the sweep, d y / d a_y by three-point differences (non-
+  // uniform central inside, one-sided second order at the first point, the
+  // a_y -> 0 value): the understeer gradient (y = delta_f), the roll gradient
+  // (y = roll) and the side-slip gradient (y = beta), ISO 4138's three.
   auto& P = out.points;
   const std::size_t n = P.size();
-  for (std::size_t i = 0; i < n; ++i) {
-    if (n < 2) break;
-    std::size_t a = i == 0 ? 0 : i - 1, b = i == 0 ? 1 : (i + 1 < n ? i + 1 : i);
-    if (i + 1 == n) a = i - 1, b = i;
-    if (i > 0 && i + 1 < n) {
-      // Non-uniform central difference.
-      const double x0 = P[i - 1].lateral_accel_m_s2, x1 = P[i].lateral_accel_m_s2, x2 = P[i + 1].lateral_accel_m_s2;
-      const double y0 = P[i - 1].front_rad, y1 = P[i].front_rad, y2 = P[i + 1].front_rad;
-      const double h0 = x1 - x0, h1 = x2 - x1;
-      P[i].understeer_gradient_rad_per_m_s2 =
-          (-h1 / (h0 * (h0 + h1))) * y0 + ((h1 - h0) / (h0 * h1)) * y1 + (h0 / (h1 * (h0 + h1))) * y2;
-    } else {
-      P[i].understeer_gradient_rad_per_m_s2 =
-          (P[b].front_rad - P[a].front_rad) / (P[b].lateral_accel_m_s2 - P[a].lateral_accel_m_s2);
+  auto gradient = [&](double ConstantRadiusPoint::*y, double ConstantRadiusPoint::*dy) -> double {
+    for (std::size_t i = 0; i < n; ++i) {
+      if (n < 2) break;
+      std::size_t a = i == 0 ? 0 : i - 1, b = i == 0 ? 1 : (i + 1 < n ? i + 1 : i);
+      if (i + 1 == n) a = i - 1, b = i;
+      if (i > 0 && i + 1 < n) {
+        const double x0 = P[i - 1].lateral_accel_m_s2, x1 = P[i].lateral_accel_m_s2, x2 = P[i + 1].lateral_accel_m_s2;
+        const double y0 = P[i - 1].*y, y1 = P[i].*y, y2 = P[i + 1].*y;
+        const double h0 = x1 - x0, h1 = x2 - x1;
+        P[i].*dy = (-h1 / (h0 * (h0 + h1))) * y0 + ((h1 - h0) / (h0 * h1)) * y1 + (h0 / (h1 * (h0 + h1))) * y2;
+      } else {
+        P[i].*dy = (P[b].*y - P[a].*y) / (P[b].lateral_accel_m_s2 - P[a].lateral_accel_m_s2);
+      }
     }
-  }
-  if (n >= 2) {
-    // At a_y -> 0: the one-sided second-order difference at the first point.
+    if (n < 2) return 0;
     if (n >= 3) {
       const double x0 = P[0].lateral_accel_m_s2, x1 = P[1].lateral_accel_m_s2, x2 = P[2].lateral_accel_m_s2;
       const double h0 = x1 - x0, h1 = x2 - x1;
-      P[0].understeer_gradient_rad_per_m_s2 = -(2 * h0 + h1) / (h0 * (h0 + h1)) * P[0].front_rad +
-                                              (h0 + h1) / (h0 * h1) * P[1].front_rad -
-                                              h0 / (h1 * (h0 + h1)) * P[2].front_rad;
+      P[0].*dy = -(2 * h0 + h1) / (h0 * (h0 + h1)) * P[0].*y + (h0 + h1) / (h0 * h1) * P[1].*y -
+                 h0 / (h1 * (h0 + h1)) * P[2].*y;
     }
-    out.understeer_gradient_linear_rad_per_m_s2 = P[0].understeer_gradient_rad_per_m_s2;
-  }
+    return P[0].*dy;
+  };
+  out.understeer_gradient_linear_rad_per_m_s2 =
+      gradient(&ConstantRadiusPoint::front_rad, &ConstantRadiusPoint::understeer_gradient_rad_per_m_s2);
+  out.roll_gradient_linear_rad_per_m_s2 =
+      gradient(&ConstantRadiusPoint::roll_rad, &ConstantRadiusPoint::roll_gradient_rad_per_m_s2);
+  out.side_slip_gradient_linear_rad_per_m_s2 =
+      gradient(&ConstantRadiusPoint::side_slip_rad, &ConstantRadiusPoint::side_slip_gradient_rad_per_m_s2);
   if (set.stability) {
     for (std::size_t i = 0; i < n; ++i) {
       if (P[i].stable) continue;

@@ -51,6 +51,8 @@ struct ConstantRadiusPoint {
   double speed_hold_force_N = 0;
   /// d delta_f / d a_y along the sweep (three-point differences), rad/(m/s^2).
   double understeer_gradient_rad_per_m_s2 = 0;
+  /// d roll / d a_y and d beta / d a_y along the sweep (the same differences), rad/(m/s^2).
+  double roll_gradient_rad_per_m_s2 = 0, side_slip_gradient_rad_per_m_s2 = 0;
   bool stable = true;                 ///< fixed-control stability (all eigenvalue real parts < -1e-6 /s)
   std::complex<double> least_damped;  ///< 1/s
   int iterations = 0, residual_evaluations = 0;
@@ -82,6 +84,8 @@ struct ConstantRadiusResult {
   double stability_lost_lateral_accel_m_s2 = std::numeric_limits<double>::quiet_NaN();
   /// Understeer gradient at the lowest lateral acceleration (linear range), rad/(m/s^2).
   double understeer_gradient_linear_rad_per_m_s2 = 0;
+  /// The roll and side-slip gradients at a_y -> 0 (the first point's), rad/(m/s^2).
+  double roll_gradient_linear_rad_per_m_s2 = 0, side_slip_gradient_linear_rad_per_m_s2 = 0;
   double wheelbase_m = 0;
   double solve_wall_time_s = 0;       ///< sum of the steady-state solves (incl. the limit's bisection)
   double stability_wall_time_s = 0;   ///< sum of the linearisations
