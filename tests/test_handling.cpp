@@ -152,15 +152,15 @@ TEST(Iso7401, FrequencyResponseMatchesSineSteerSimulations) {
   // Linear tires: the Gim tire's lateral force has a |alpha| kink at zero slip
   // (straight running), so its sine response deviates from the tangent
   // linearisation in proportion to the amplitude (0.4 deg of phase at 0.002 rad).
-  auto b = bike(std::getenv("VDYN_TIRE") ? std::getenv("VDYN_TIRE") : "linear");
+  auto b = bike("linear");
   const double U = 80.0 / 3.6;
   const std::vector<double> freqs = {0.5, 1.0, 2.0};
   const FrequencyResponseResult fr = calcSteeringFrequencyResponse(b->vehicle, U, freqs);
   IntegratorSettings integ;
   integ.accuracy = 1e-8;
   for (std::size_t i = 0; i < freqs.size(); ++i) {
-    const double settle = std::getenv("VDYN_SETTLE") ? std::atof(std::getenv("VDYN_SETTLE")) : 2.0;
-    const double amp = std::getenv("VDYN_AMP") ? std::atof(std::getenv("VDYN_AMP")) : 0.002;
+    const double settle = 2.0;
+    const double amp = 0.002;
     const SineSteerResult s = runSineSteer(b->vehicle, U, freqs[i], amp, integ, 1, settle, 2);
     const FrequencyResponsePoint& l = fr.points[i];
     std::printf("%.2f Hz: yaw gain sim %.6f lin %.6f, phase sim %.4f lin %.4f deg; a_y gain sim %.5f lin %.5f, phase "
@@ -171,6 +171,40 @@ TEST(Iso7401, FrequencyResponseMatchesSineSteerSimulations) {
     EXPECT_NEAR(s.ay_gain_m_s2_per_rad, l.ay_gain_m_s2_per_rad, 0.01 * l.ay_gain_m_s2_per_rad);
     EXPECT_NEAR(s.yaw_phase_deg, l.yaw_phase_deg, 0.01 * std::abs(l.yaw_phase_deg));
     EXPECT_NEAR(s.ay_phase_deg, l.ay_phase_deg, 0.01 * std::abs(l.ay_phase_deg));
+  }
+}
+
+// ISO 7401's named figures of the frequency response (the linear bicycle at
+// 80 km/h): the 1 Hz phases and a_y gain ratio are the response's values at
+// 1 Hz, the yaw-rate phase at 1 Hz matches a sine-steer simulation at 1 Hz
+// (an independent method) to 1 %, and the resonance is a local maximum of
+// the yaw gain with the peak ratio its gain over the steady one.
+TEST(Iso7401, NamedFiguresOfTheFrequencyResponse) {
+  auto b = bike("linear");
+  const double U = 80.0 / 3.6;
+  const FrequencyResponseResult fr = calcSteeringFrequencyResponse(b->vehicle, U, {1.0});
+  EXPECT_EQ(fr.yaw_phase_1Hz_deg, fr.points[0].yaw_phase_deg);
+  EXPECT_EQ(fr.ay_phase_1Hz_deg, fr.points[0].ay_phase_deg);
+  EXPECT_NEAR(fr.ay_gain_ratio_1Hz, fr.points[0].ay_gain_m_s2_per_rad / fr.ay_gain_zero_m_s2_per_rad, 1e-15);
+  IntegratorSettings integ;
+  integ.accuracy = 1e-8;
+  const SineSteerResult sim = runSineSteer(b->vehicle, U, 1.0, 0.002, integ, 1, 2.0, 2);
+  EXPECT_NEAR(sim.yaw_phase_deg, fr.yaw_phase_1Hz_deg, 0.01 * std::abs(fr.yaw_phase_1Hz_deg));
+  std::printf("80 km/h: yaw phase at 1 Hz %.4f deg (sine steer %.4f), a_y phase %.4f deg, a_y gain ratio %.5f; "
+              "resonance %.6f Hz, peak ratio %.6f\n",
+              fr.yaw_phase_1Hz_deg, sim.yaw_phase_deg, fr.ay_phase_1Hz_deg, fr.ay_gain_ratio_1Hz,
+              fr.yaw_resonance_frequency_Hz, fr.yaw_peak_ratio);
+  if (std::isnan(fr.yaw_resonance_frequency_Hz)) {
+    // No peak: the gain falls from its steady value over the whole scan.
+    const FrequencyResponseResult lo = calcSteeringFrequencyResponse(b->vehicle, U, {0.01, 0.02});
+    EXPECT_LT(lo.points[1].yaw_gain_1_per_s, lo.points[0].yaw_gain_1_per_s);
+  } else {
+    const double f = fr.yaw_resonance_frequency_Hz;
+    const FrequencyResponseResult n = calcSteeringFrequencyResponse(b->vehicle, U, {f * 0.999, f, f * 1.001});
+    EXPECT_LE(n.points[0].yaw_gain_1_per_s, n.points[1].yaw_gain_1_per_s);
+    EXPECT_LE(n.points[2].yaw_gain_1_per_s, n.points[1].yaw_gain_1_per_s);
+    EXPECT_NEAR(fr.yaw_peak_ratio, n.points[1].yaw_gain_1_per_s / fr.yaw_gain_zero_1_per_s, 1e-12);
+    EXPECT_GT(fr.yaw_peak_ratio, 1.0);
   }
 }
 

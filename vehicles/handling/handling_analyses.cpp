@@ -144,6 +144,11 @@ class Iso7401Analysis : public Analysis {
                    {"lateral_accel_response_time_s", st.lateral_accel_response_time_s},
                    {"lateral_accel_overshoot", st.lateral_accel_overshoot},
                    {"linear_yaw_gain_zero_1_per_s", fr.yaw_gain_zero_1_per_s},
+                   {"yaw_rate_resonance_frequency_Hz", nullIfNan(fr.yaw_resonance_frequency_Hz)},
+                   {"yaw_rate_peak_ratio", nullIfNan(fr.yaw_peak_ratio)},
+                   {"yaw_rate_phase_1Hz_deg", fr.yaw_phase_1Hz_deg},
+                   {"lateral_accel_phase_1Hz_deg", fr.ay_phase_1Hz_deg},
+                   {"lateral_accel_gain_ratio_1Hz", fr.ay_gain_ratio_1Hz},
                    {"linear_stable", fr.stable}};
     return res;
   }

@@ -187,6 +187,31 @@ FrequencyResponseResult calcSteeringFrequencyResponse(const HandlingVehicle& v, 
     p.ay_phase_deg = std::arg(G(1, 0)) * 180 / kPi;
     out.points.push_back(p);
   }
+  // ISO 7401's named figures of the frequency response, from the same linear model.
+  const Eigen::MatrixXcd G1 = lin.calcResponse(2 * kPi * 1.0);
+  out.yaw_phase_1Hz_deg = std::arg(G1(0, 0)) * 180 / kPi;
+  out.ay_phase_1Hz_deg = std::arg(G1(1, 0)) * 180 / kPi;
+  out.ay_gain_zero_m_s2_per_rad = std::abs(lin.calcResponse(1e-9)(1, 0));
+  out.ay_gain_ratio_1Hz = std::abs(G1(1, 0)) / out.ay_gain_zero_m_s2_per_rad;
+  // Yaw-rate resonance: the largest |r / delta| over 0.01-10 Hz (a log scan of
+  // 400 points, then golden-section search in log f to 1e-9 relative); none
+  // when the largest is at the lowest frequency (no peak: the gain falls).
+  auto gain = [&](double f) { return std::abs(lin.calcResponse(2 * kPi * f)(0, 0)); };
+  const std::vector<double> scan = logFrequencies(0.01, 10.0, 400);
+  std::size_t k = 0;
+  for (std::size_t i = 1; i < scan.size(); ++i)
+    if (gain(scan[i]) > gain(scan[k])) k = i;
+  if (k > 0 && k + 1 < scan.size()) {
+    double a = std::log(scan[k - 1]), b = std::log(scan[k + 1]);
+    const double g = 0.5 * (std::sqrt(5.0) - 1);
+    double c = b - g * (b - a), d = a + g * (b - a);
+    while (b - a > 1e-9) {
+      if (gain(std::exp(c)) > gain(std::exp(d))) b = d; else a = c;
+      c = b - g * (b - a), d = a + g * (b - a);
+    }
+    out.yaw_resonance_frequency_Hz = std::exp(0.5 * (a + b));
+    out.yaw_peak_ratio = gain(out.yaw_resonance_frequency_Hz) / out.yaw_gain_zero_1_per_s;
+  }
   out.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
 }

@@ -4,6 +4,7 @@
 // steering angle from the linearisation about straight running
 // (SteadyStateSolver::calcLinearModel with the steering command as input),
 // and a sine-steer simulation to cross-check one frequency.
+#include <limits>
 #include <vector>
 
 #include "vdyn/handling/handling.h"
@@ -64,6 +65,15 @@ struct FrequencyResponseResult {
   double speed_m_s = 0;
   std::vector<FrequencyResponsePoint> points;
   double yaw_gain_zero_1_per_s = 0;   ///< |G(0)| of the yaw rate (the steady gain), 1/s
+  double ay_gain_zero_m_s2_per_rad = 0;  ///< |G(0)| of the lateral acceleration, m/s^2 per rad
+  // ISO 7401's named figures (same linear model):
+  double yaw_phase_1Hz_deg = 0;       ///< phase of r / delta_f at 1 Hz, deg (< 0: lag)
+  double ay_phase_1Hz_deg = 0;        ///< phase of a_y / delta_f at 1 Hz, deg
+  double ay_gain_ratio_1Hz = 0;       ///< |a_y / delta_f| at 1 Hz over its steady value
+  /// Frequency of the largest |r / delta_f| in 0.01-10 Hz, Hz; NaN when the
+  /// gain only falls from its steady value (no resonance).
+  double yaw_resonance_frequency_Hz = std::numeric_limits<double>::quiet_NaN();
+  double yaw_peak_ratio = std::numeric_limits<double>::quiet_NaN();  ///< the peak gain over the steady gain
   int dimension = 0;                  ///< independent states of the linear model
   bool stable = false;
   double wall_time_s = 0;
