@@ -756,3 +756,25 @@ TEST(Iso4138, E90ReachesItsLimitOnTheRadiusAndItsBarsReduceRoll) {
               r.limit_speed_m_s, r.limit_lateral_accel_m_s2, r.points[1].speed_m_s, r.points[1].roll_rad / kDeg,
               n.points[1].roll_rad / kDeg);
 }
+
+// The vehicle report on App. A with a solid rear axle
+// (appendix_a_solid_rear.json): loads and heights as for any car (sum = weight
+// to 1e-9, the front axle load = the moment balance to 1e-6), the front's
+// kinematics swept, the dependent rear axle named as not swept with the reason.
+TEST(VehicleReport, SolidRearAxleLoadsAndTheAxleItCannotSweep) {
+  const Json scene = {{"name", "report_solid"},
+                      {"vehicle", {{"type", "wheeled"}, {"data", "appendix_a_solid_rear.json"}}},
+                      {"analysis", {{"type", "vehicle_report"}}}};
+  const VehicleReport r =
+      makeVehicleReport(SceneDescription::fromJson(scene, "", standardRegistry()), {-0.04, 0.0, 0.04});
+  EXPECT_NEAR(r.total_load_N, r.weight_N, 1e-9 * r.weight_N);
+  EXPECT_NEAR(r.front_axle_load_N, r.front_axle_load_from_moments_N, 1e-6 * r.front_axle_load_N);
+  ASSERT_EQ(r.kinematics.size(), 1u);
+  EXPECT_EQ(r.kinematics[0].first, "front");
+  ASSERT_EQ(r.kinematics_not_swept.size(), 1u);
+  EXPECT_EQ(r.kinematics_not_swept[0].first, "rear");
+  EXPECT_NE(r.kinematics_not_swept[0].second.find("'solid_axle' has no single-coordinate kinematics sweep (a dependent "
+                                                  "axle"),
+            std::string::npos)
+      << r.kinematics_not_swept[0].second;
+}

@@ -350,6 +350,7 @@ class VehicleReportAnalysis : public Analysis {
     }
     if (!rep.added_plugins.empty() || !rep.replaced_plugins.empty())
       res.summary["plugins"] = {{"replaced", rep.replaced_plugins}, {"added", rep.added_plugins}};
+    for (const auto& [axle, why] : rep.kinematics_not_swept) res.summary["kinematics_not_swept"][axle] = why;
     for (const auto& [axle, pts] : rep.kinematics) {
       Table t;
       t.columns = {"travel_m", "camber_deg", "toe_in_deg", "track_change_m", "recession_m", "wheel_rate_N_per_m",

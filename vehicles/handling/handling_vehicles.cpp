@@ -237,9 +237,16 @@ VehicleReport makeWheeledReport(const HandlingScene& h, const std::vector<double
   const double y0 = car.chassis().getBodyOriginLocation(s)[1];
   for (int ax = 0; ax < car.numAxles(); ++ax) {
     KinematicCorner kc;
-    if (!car.suspension(ax).getKinematicCorner(0, &kc))
-      throw Error("vehicle_report: suspension template '" + car.suspension(ax).templateName() + "' of axle '" +
-                  params.axles[ax].name + "' has no kinematics sweep (use its constrained template)");
+    if (!car.suspension(ax).getKinematicCorner(0, &kc)) {
+      const std::string& t = car.suspension(ax).templateName();
+      rep.kinematics_not_swept.push_back(
+          {params.axles[ax].name,
+           "suspension template '" + t + "' has no single-coordinate kinematics sweep" +
+               (car.suspension(ax).getAssemblyTemplate().empty()
+                    ? std::string(" (a dependent axle: its travel moves both wheels)")
+                    : " (sweep its constrained template '" + car.suspension(ax).getAssemblyTemplate() + "')")});
+      continue;
+    }
     SuspensionCorner k;
     k.name = car.cornerName(2 * ax);
     k.lower_arm = kc.travel_body;

@@ -86,6 +86,10 @@ struct VehicleReport {
   double front_axle_load_from_moments_N = 0;
   /// Per axle (a corner standing for it: "front" = rf, "rear" = rr; the quarter car: "corner").
   std::vector<std::pair<std::string, std::vector<KinematicsPoint>>> kinematics;
+  /// Axles whose template has no single-coordinate kinematics sweep (a
+  /// dependent axle, whose travel moves both wheels), with the reason: their
+  /// loads and heights are in the report, their kinematics are not.
+  std::vector<std::pair<std::string, std::string>> kinematics_not_swept;
   std::vector<std::string> replaced_plugins, added_plugins;  ///< as in HandlingScene
 };
 
