@@ -1,8 +1,9 @@
 #!/usr/bin/env bash
 # Builds the data-file reader's libFuzzer target with clang (ASan + UBSan) and
 # runs it for a fixed budget:  tests/fuzz/run_fuzz.sh [SECONDS=600] [JOBS=1]
-# Seed corpus: tests/fuzz/corpus (in the repository; nested and oversized
-# inputs among them), dictionary tests/fuzz/json.dict; inputs up to 256 KiB
+# Seed corpus: tests/fuzz/corpus (hand-made nested, oversized and malformed
+# inputs) and the shipped data files themselves, vehicles/data (read
+# recursively, so the seeds never go stale against the data), dictionary tests/fuzz/json.dict; inputs up to 256 KiB
 # (-max_len: deep nesting needs length); the growing corpus and
 # any crash-* files go to build-fuzz/ (git-ignored). A crash is a finding: add
 # its input to tests/fuzz/corpus and a test that reproduces it.
@@ -37,7 +38,7 @@ echo "fuzzing for ${budget} s"
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 par=()
 [ "$jobs" -gt 1 ] && par=(-fork="$jobs")
-"$out/fuzz_params" "$out/corpus" tests/fuzz/corpus -max_total_time="$budget" "${par[@]}" \
+"$out/fuzz_params" "$out/corpus" tests/fuzz/corpus vehicles/data -max_total_time="$budget" "${par[@]}" \
   -artifact_prefix="$out/artifacts/" -print_final_stats=1 -dict=tests/fuzz/json.dict -max_len=262144 -len_control=20 \
   -timeout=10 2>&1 | tee "$out/fuzz.log" | tail -40
 if ls "$out"/artifacts/crash-* "$out"/artifacts/leak-* "$out"/artifacts/timeout-* > /dev/null 2>&1; then
