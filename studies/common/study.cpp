@@ -205,46 +205,25 @@ void checkRunTimes(const Given& tEnd, const Given& dt) {
 }
 
 void plot(const std::vector<PlotSpec>& plots) {
-  if (!gnuplotAvailable())
-    throw Error("gnuplot not found: the PNG plots need it (apt-get install gnuplot-nox)");
   for (const PlotSpec& p : plots) {
-    const std::string script = p.png + ".gp";
-    std::ostringstream g;
-    g << "set terminal pngcairo size 1000,650 font 'sans,10'\n"
-      << "set output " << gnuplotQuote(p.png) << "\n"
-      << "set datafile separator ','\nset key autotitle columnhead\nset grid\n"
-      << "set title " << gnuplotQuote(p.title) << " noenhanced\n"
-      << "set xlabel " << gnuplotQuote(p.xlabel) << " noenhanced\nset ylabel " << gnuplotQuote(p.ylabel) << " noenhanced\n"
-      << "set key noenhanced\n";
-    if (p.equal_axes) g << "set size ratio -1\n";
-    if (p.logx) g << "set logscale x\nset format x '10^{%L}'\n";
-    if (p.logy) g << "set logscale y\nset format y '10^{%L}'\n";
-        g << "plot ";
-    for (std::size_t i = 0; i < p.series.size(); ++i) {
-      const Series& s = p.series[i];
-      std::string y = "column(" + gnuplotQuote(s.y) + ")";
-      if (!s.filter.empty()) {
-        std::string cond;
-        std::size_t start = 0;
-        while (start <= s.filter.size()) {
-          const std::size_t end = std::min(s.filter.find(';', start), s.filter.size());
-          const std::string term = s.filter.substr(start, end - start);
-          const auto eq = term.find('=');
-          if (eq == std::string::npos) throw Error("plot filter '" + s.filter + "': expected column=value terms");
-          cond += (cond.empty() ? "" : " && ") + std::string("strcol(") + gnuplotQuote(term.substr(0, eq)) + ") eq " +
-                  gnuplotQuote(term.substr(eq + 1));
-          start = end + 1;
-        }
-        y = "((" + cond + ") ? " + y + " : NaN)";
+    vdyn::PlotSpec f;
+    f.title = p.title, f.xlabel = p.xlabel, f.ylabel = p.ylabel;
+    f.equal_axes = p.equal_axes, f.logx = p.logx, f.logy = p.logy, f.points = p.points;
+    for (const Series& s : p.series) {
+      vdyn::PlotSeries q{s.csv, s.x, s.y, s.label};
+      q.style = s.style;
+      std::size_t start = 0;
+      while (!s.filter.empty() && start <= s.filter.size()) {
+        const std::size_t end = std::min(s.filter.find(';', start), s.filter.size());
+        const std::string term = s.filter.substr(start, end - start);
+        const auto eq = term.find('=');
+        if (eq == std::string::npos) throw Error("plot filter '" + s.filter + "': expected column=value terms");
+        q.where.emplace_back(term.substr(0, eq), term.substr(eq + 1));
+        start = end + 1;
       }
-      g << (i ? ", \\\n     " : "") << gnuplotQuote(s.csv) << " using (column(" << gnuplotQuote(s.x) << ")):(" << y << ")"
-        << (!s.style.empty() ? " " + s.style + " title "
-                             : p.points ? std::string(" with linespoints lw 2 pt 7 title ") : " with lines lw 2 title ")
-        << gnuplotQuote(s.label);
+      f.series.push_back(q);
     }
-    g << "\n";
-    writeFileAtomic(script, g.str());
-    runGnuplot(script, p.png);
+    renderFigure(f, p.png, [](const std::string& csv) { return csv; });
   }
 }
 

@@ -47,10 +47,9 @@ std::string lastSegment(const std::string& path) {
 }
 
 /// Renders the sweep file's plots from results.csv with gnuplot (script kept as <png>.gp).
-void renderPlots(const SweepDescription& d, const SweepResult& r, const std::string& dir) {
+void renderSweepPlots(const SweepDescription& d, const SweepResult& r, const std::string& dir) {
   if (d.plots.empty()) return;
-  if (std::system("command -v gnuplot > /dev/null 2>&1") != 0)
-    throw Error("gnuplot not found: the sweep's plots need it (apt-get install gnuplot-nox)");
+  if (!gnuplotAvailable()) throw Error("gnuplot not found: the sweep's plots need it (apt-get install gnuplot-nox)");
   const std::string csv = dir + "/results.csv";
   auto distinct = [&](const std::string& column) {
     std::vector<std::string> v;
@@ -70,39 +69,35 @@ void renderPlots(const SweepDescription& d, const SweepResult& r, const std::str
     return v;
   };
   for (const SweepPlot& p : d.plots) {
-    const std::string png = dir + "/" + p.png, script = png + ".gp";
     const auto panels = distinct(p.panels), series = distinct(p.series);
-    const int cols = int(std::ceil(std::sqrt(double(panels.size()))));
-    const int rows = int((panels.size() + cols - 1) / cols);
-    std::ostringstream g;
-    g << "set terminal pngcairo size " << 640 * cols << "," << 480 * rows + 40 << " font 'sans,9'\n"
-      << "set output " << gnuplotQuote(png) << "\nset datafile separator ','\nset grid\nset key noenhanced\n"
-      << "set xlabel " << gnuplotQuote(p.x_label.empty() ? p.x : p.x_label) << " noenhanced\n"
-      << "set ylabel " << gnuplotQuote(p.y_label.empty() ? p.y : p.y_label) << " noenhanced\n";
-    if (panels.size() > 1 || !p.title.empty())
-      g << "set multiplot layout " << rows << "," << cols << " title " << gnuplotQuote(p.title) << " noenhanced\n";
+    PlotSpec fig;
+    fig.name = p.png;
+    fig.title = p.title;
     for (const std::string& panel : panels) {
-      if (!p.panels.empty())
-        g << "set title " << gnuplotQuote((p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel)
-          << " noenhanced\n";
-      g << "plot ";
-      bool first = true;
+      PlotSpec q;
+      q.xlabel = p.x_label.empty() ? p.x : p.x_label;
+      q.ylabel = p.y_label.empty() ? p.y : p.y_label;
+      q.title = p.panels.empty() ? p.title
+                                 : (p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel;
       for (const std::string& s : series) {
-        std::string cond = "strcol(\"status\") eq \"ok\"";
-        if (!p.panels.empty()) cond += " && strcol(" + gnuplotQuote(p.panels) + ") eq " + gnuplotQuote(panel);
-        if (!p.series.empty()) cond += " && strcol(" + gnuplotQuote(p.series) + ") eq " + gnuplotQuote(s);
-        g << (first ? "" : ", \\\n     ") << gnuplotQuote(csv) << " using (column(" << gnuplotQuote(p.x) << ")*" << formatValue(p.x_scale)
-          << "):((" << cond << ") ? column(" << gnuplotQuote(p.y) << ")*" << formatValue(p.y_scale)
-          << " : NaN) with linespoints lw 2 pt 7 ps 0.6 title "
-          << gnuplotQuote(p.series.empty() ? lastSegment(p.y)
-                                      : (p.series_label.empty() ? lastSegment(p.series) : p.series_label) + " = " + s);
-        first = false;
+        PlotSeries c{csv, p.x, p.y,
+                     p.series.empty() ? lastSegment(p.y)
+                                      : (p.series_label.empty() ? lastSegment(p.series) : p.series_label) + " = " + s};
+        c.x_scale = p.x_scale, c.y_scale = p.y_scale;
+        c.where = {{"status", "ok"}};
+        if (!p.panels.empty()) c.where.emplace_back(p.panels, panel);
+        if (!p.series.empty()) c.where.emplace_back(p.series, s);
+        c.style = "with linespoints lw 2 pt 7 ps 0.6";
+        q.series.push_back(c);
       }
-      g << "\n";
+      fig.panels.push_back(q);
     }
-    if (panels.size() > 1 || !p.title.empty()) g << "unset multiplot\n";
-    writeFileAtomic(script, g.str());
-    runGnuplot(script, png);
+    if (fig.panels.size() == 1 && p.panels.empty()) {  // one panel: the figure itself
+      const std::string title = fig.title;
+      fig = fig.panels.front();
+      fig.title = title;
+    }
+    renderFigure(fig, dir + "/" + p.png, [](const std::string& path) { return path; });
   }
 }
 
@@ -171,7 +166,7 @@ int sweepCommand(const std::vector<std::string>& args) {
     if (manager && !quiet) so.progress = sweepProgressPrinter("vdyn sweep");
     try {
       r = runSweepMpi(sweep, run, so);
-      if (manager && !vm.count("no-plots")) renderPlots(sweep, r, out);
+      if (manager && !vm.count("no-plots")) renderSweepPlots(sweep, r, out);
     } catch (const std::exception& e) {
       std::fprintf(stderr, "vdyn sweep: error (MPI rank %d): %s\n", mpi.rank(), e.what());
       if (mpi.size() > 1) MpiSession::abort(1);  // the other ranks would wait for it forever
@@ -183,7 +178,7 @@ int sweepCommand(const std::vector<std::string>& args) {
     if (!quiet) so.progress = sweepProgressPrinter("vdyn sweep");
     installInterruptHandlers();  // SIGINT/SIGTERM: stop between variations, write the finished rows
     r = runSweep(sweep, run, so);
-    if (!vm.count("no-plots")) renderPlots(sweep, r, out);
+    if (!vm.count("no-plots")) renderSweepPlots(sweep, r, out);
   }
   if (!manager) return 0;
   std::printf("vdyn sweep: %s: %zu variations, %zu run now (%zu from the journal), %zu failed; %.2f s wall, %.2f s CPU, "

@@ -61,6 +61,87 @@ struct Iso3888Keys {
 
 Json nullIfNan(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
+/// ISO 4138's panels against lateral acceleration: each quantity on the
+/// branch up to the limit (the fold, marked), the gradients' axes scaled to
+/// the points below 90 % of the limit, where a gradient is defined (at the
+/// fold d a_y -> 0 and the gradients grow without bound).
+PlotSpec iso4138Figure(const ConstantRadiusResult& r, const std::string& vehicle) {
+  const double limit = r.limit_found ? r.limit_lateral_accel_m_s2 : NAN;
+  const double xMax = std::isfinite(limit) ? 1.04 * limit : NAN;
+  // The range of a gradient over the points where it is defined, widened by 15 %.
+  auto gradientRange = [&](auto get, double& lo, double& hi) {
+    lo = INFINITY, hi = -INFINITY;
+    for (const auto& p : r.points) {
+      const double g = get(p) / kDeg;
+      if (!std::isfinite(g) || (std::isfinite(limit) && p.lateral_accel_m_s2 > 0.9 * limit)) continue;
+      lo = std::min(lo, g), hi = std::max(hi, g);
+    }
+    if (!(lo <= hi)) {
+      lo = hi = NAN;
+      return;
+    }
+    const double pad = 0.15 * std::max(hi - lo, 0.05 * std::max(std::abs(lo), std::abs(hi)) + 1e-9);
+    lo -= pad, hi += pad;
+  };
+  std::vector<PlotMarker> marks;
+  if (std::isfinite(limit)) marks.push_back({limit, "limit " + formatValue(std::round(limit * 1000) / 1000) + " m/s^2"});
+  auto panel = [&](std::string title, std::string ylabel, std::vector<PlotSeries> series) {
+    PlotSpec p;
+    p.title = std::move(title), p.xlabel = "lateral acceleration a_y (m/s^2)", p.ylabel = std::move(ylabel);
+    p.series = std::move(series);
+    p.points = true, p.x_min = 0, p.x_max = xMax, p.markers = marks;
+    return p;
+  };
+  const std::string x = "lateral_accel_m_s2";
+  PlotSpec f;
+  f.name = "iso4138";
+  f.title = "ISO 4138 constant radius " + formatValue(r.radius_m) + " m: " + vehicle;
+  f.columns = 3;
+  f.panels = {panel("front steer angle", "angle (deg)",
+                    {{"iso4138", x, "front_deg", "front angle"}, {"iso4138", x, "delta_minus_l_over_R_deg", "front - l/R"}}),
+              panel("understeer gradient", "deg/(m/s^2)", {{"iso4138", x, "understeer_gradient_deg_per_m_s2", ""}}),
+              panel("roll angle", "roll (deg)", {{"iso4138", x, "roll_deg", ""}}),
+              panel("roll gradient", "deg/(m/s^2)", {{"iso4138", x, "roll_gradient_deg_per_m_s2", ""}}),
+              panel("side slip", "side slip (deg)", {{"iso4138", x, "side_slip_deg", ""}}),
+              panel("side-slip gradient", "deg/(m/s^2)", {{"iso4138", x, "side_slip_gradient_deg_per_m_s2", ""}}),
+              panel("least-damped eigenvalue (< 0: stable)", "real part (1/s)",
+                    {{"iso4138", x, "least_damped_re_per_s", ""}}),
+              panel("speed", "speed (m/s)", {{"iso4138", x, "speed_m_s", ""}})};
+  gradientRange([](const ConstantRadiusPoint& p) { return p.understeer_gradient_rad_per_m_s2; }, f.panels[1].y_min,
+                f.panels[1].y_max);
+  gradientRange([](const ConstantRadiusPoint& p) { return p.roll_gradient_rad_per_m_s2; }, f.panels[3].y_min,
+                f.panels[3].y_max);
+  gradientRange([](const ConstantRadiusPoint& p) { return p.side_slip_gradient_rad_per_m_s2; }, f.panels[5].y_min,
+                f.panels[5].y_max);
+  return f;
+}
+
+/// ISO 7401's frequency response as Bode plots: gains (ratio) and phases
+/// (deg) on a logarithmic frequency axis, 1 Hz and the yaw resonance marked.
+PlotSpec bodeFigure(const FrequencyResponseResult& fr, const std::string& vehicle, double speed_m_s) {
+  std::vector<PlotMarker> marks = {{1.0, "1 Hz"}};
+  if (std::isfinite(fr.yaw_resonance_frequency_Hz))
+    marks.push_back({fr.yaw_resonance_frequency_Hz,
+                     "yaw resonance " + formatValue(std::round(fr.yaw_resonance_frequency_Hz * 1000) / 1000) + " Hz"});
+  auto panel = [&](std::string title, std::string ylabel, std::string y) {
+    PlotSpec p;
+    p.title = std::move(title), p.xlabel = "steering frequency (Hz)", p.ylabel = std::move(ylabel);
+    p.series = {{"frequency_response", "frequency_Hz", y, ""}};
+    p.logx = true, p.markers = marks;
+    return p;
+  };
+  PlotSpec f;
+  f.name = "frequency_response";
+  f.title = "ISO 7401 frequency response (linearised about straight running at " + formatValue(speed_m_s) +
+            " m/s): " + vehicle;
+  f.columns = 2;
+  f.panels = {panel("yaw-rate gain r / delta", "gain (1/s)", "yaw_gain_1_per_s"),
+              panel("yaw-rate phase", "phase (deg)", "yaw_phase_deg"),
+              panel("lateral-acceleration gain a_y / delta", "gain ((m/s^2)/rad)", "ay_gain_m_s2_per_rad"),
+              panel("lateral-acceleration phase", "phase (deg)", "ay_phase_deg")};
+  return f;
+}
+
 class ConstantRadiusAnalysis : public Analysis {
  public:
   explicit ConstantRadiusAnalysis(const ParamReader& r)
@@ -85,6 +166,7 @@ class ConstantRadiusAnalysis : public Analysis {
                         p.speed_hold_force_N, p.roll_gradient_rad_per_m_s2 / kDeg,
                         p.side_slip_gradient_rad_per_m_s2 / kDeg});
     res.tables.push_back({"iso4138", t});
+    res.plots.push_back(iso4138Figure(r, b->vehicle.name));
     res.summary = {{"vehicle", b->vehicle.name},
                    {"plugins", b->describePlugins()},
                    {"radius_m", r.radius_m},
@@ -133,6 +215,7 @@ class Iso7401Analysis : public Analysis {
       f.rows.push_back({q.frequency_Hz, q.yaw_gain_1_per_s, q.yaw_phase_deg, q.ay_gain_m_s2_per_rad, q.ay_phase_deg});
     res.tables.push_back({"step_steer", step});
     res.tables.push_back({"frequency_response", f});
+    res.plots.push_back(bodeFigure(fr, b->vehicle.name, s_.speed_m_s));
     res.summary = {{"vehicle", b->vehicle.name},
                    {"plugins", b->describePlugins()},
                    {"front_deg", st.front_rad / kDeg},

@@ -6,6 +6,7 @@
 // object, whose settings the factory reads (and so validates) at load time.
 // Following the Drake convention, run() is public and non-virtual: it checks
 // the context and calls the protected DoRun().
+#include <cmath>
 #include <functional>
 #include <memory>
 #include <string>
@@ -28,14 +29,30 @@ struct Table {
   void writeCsv(const std::string& path) const;
 };
 
-/// One line of a plot: columns x and y of one of the result's tables.
+/// One line of a plot: columns x and y of a table (an analysis's table by
+/// name, or a CSV file by path where the caller resolves names so: see
+/// renderFigure in plot.h).
 struct PlotSeries {
-  std::string table;          ///< a table of the same AnalysisResult
+  std::string table;          ///< a table of the same AnalysisResult (or a CSV path)
   std::string x, y;           ///< column names
   std::string label;          ///< legend ("" = the y column's name)
+  double x_scale = 1, y_scale = 1;  ///< drawn: column x x_scale, column y x y_scale (unit conversion)
+  /// Only rows where every (column, text) pair matches (compared as text).
+  std::vector<std::pair<std::string, std::string>> where = {};
+  std::string style = "";     ///< gnuplot style replacing the panel's ("with points pt 7")
+  /// Remove the 2 pi x y_scale jumps of an angle wrapped to +-pi (yaw).
+  bool unwrap = false;
 };
 
-/// A PNG an analysis asks for (rendered by runScene with gnuplot, plot.h).
+/// A vertical line at x with a label (a limit, a fold, a resonance).
+struct PlotMarker {
+  double x = 0;
+  std::string label;
+};
+
+/// A PNG an analysis asks for (rendered by runScene with gnuplot, plot.h):
+/// one panel, or, when `panels` is not empty, a figure of those panels (the
+/// figure's own series and axes unused) under `title`.
 struct PlotSpec {
   std::string name;           ///< file <name>.png in the output folder
   std::string title, xlabel, ylabel;
@@ -43,6 +60,12 @@ struct PlotSpec {
   bool equal_axes = false;    ///< same scale on x and y (trajectories)
   bool logx = false;
   bool points = false;        ///< lines with point markers
+  bool logy = false;
+  /// Axis ranges in the drawn units (NaN: from the data).
+  double x_min = NAN, x_max = NAN, y_min = NAN, y_max = NAN;
+  std::vector<PlotMarker> markers = {};
+  std::vector<PlotSpec> panels = {};
+  int columns = 0;            ///< panels per row (0: chosen from their number)
 };
 
 /// What an analysis hands back.

@@ -142,11 +142,15 @@ class Suspension {
   /// The rack given by setRack(); throws Error naming the template if none was.
   const SimTK::MobilizedBody& getRack() const;
 
-  /// A spring's two mounts: a station on each of two bodies (body frames, m).
+  /// A spring's two mounts: station p_a (m, in a's frame) on body a, the
+  /// chassis side, and p_b (m, in b's frame) on body b, the suspension side;
+  /// filled as {a, p_a, b, p_b}.
   struct SpringMount {
-    bool valid = false;
-    SimTK::MobilizedBody a, b;
-    SimTK::Vec3 p_a{0}, p_b{0};
+    SimTK::MobilizedBody a;
+    SimTK::Vec3 p_a{0};
+    SimTK::MobilizedBody b;
+    SimTK::Vec3 p_b{0};
+    bool valid = false;  ///< set by addSpringMount
   };
   /// Called by DoBuildCorner: registers side's spring mounts (a on the
   /// chassis side, b on the suspension) and adds the corner's stops along the

@@ -157,12 +157,7 @@ bool DoubleWishboneSuspension::getKinematicCorner(int side, KinematicCorner* k) 
 Suspension::SpringMount DoubleWishboneSuspension::springMount(const SimTK::MobilizedBody& chassis,
                                                              const SimTK::MobilizedBody& lowerArm,
                                                              const DoubleWishboneParams& p) {
-  SpringMount m;
-  m.a = chassis;
-  m.p_a = p.spring_chassis_point_m;
-  m.b = lowerArm;
-  m.p_b = p.spring_arm_point_m;
-  return m;
+  return {chassis, p.spring_chassis_point_m, lowerArm, p.spring_arm_point_m};
 }
 
 void DoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side,

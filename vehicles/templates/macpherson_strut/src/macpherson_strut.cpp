@@ -189,12 +189,7 @@ void MacPhersonStrutSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody
   scene.addBody(prefix + "lower_arm", c.lower_arm);
   scene.addBody(prefix + "knuckle", c.upright);
   scene.addBody(prefix + "wheel", c.wheel);
-  SpringMount m;
-  m.a = chassis;
-  m.p_a = p.strut_chassis_m;
-  m.b = c.upright;
-  m.p_b = p.strut_upright_m - cu;
-  addSpringMount(scene, side, prefix, m, p.stops);
+  addSpringMount(scene, side, prefix, {chassis, p.strut_chassis_m, c.upright, p.strut_upright_m - cu}, p.stops);
 }
 
 void registerMacPhersonStrut(PluginRegistry& registry) {

@@ -218,12 +218,7 @@ void SolidAxleSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chas
   scene.addBody(prefix + "axle", housing_);  // the same body under both corners' names
   scene.addBody(prefix + "knuckle", k.knuckle);
   scene.addBody(prefix + "wheel", k.wheel);
-  SpringMount m;
-  m.a = chassis;
-  m.p_a = p.spring_chassis_m[side];
-  m.b = housing_;
-  m.p_b = p.spring_axle_m[side] - c;
-  addSpringMount(scene, side, prefix, m, p.stops);
+  addSpringMount(scene, side, prefix, {chassis, p.spring_chassis_m[side], housing_, p.spring_axle_m[side] - c}, p.stops);
 }
 
 void registerSolidAxle(PluginRegistry& registry) {

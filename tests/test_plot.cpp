@@ -1,0 +1,239 @@
+// The one gnuplot writer (vdyn/core/plot.h), checked on the PNGs it writes:
+// a minimal PNG reader (zlib, the five row filters) finds the drawn line
+// colour in each panel of the grid, so an empty panel, a lost column or an
+// angle left wrapped fails a test. Also the ISO 4138 and ISO 7401 figures of
+// `vdyn run` (log frequency axis, limit marked).
+#include <gtest/gtest.h>
+#include <zlib.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <set>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "vdyn/core/analysis.h"
+#include "vdyn/core/plot.h"
+
+namespace fs = std::filesystem;
+using namespace vdyn;
+
+namespace {
+
+struct Image {
+  int width = 0, height = 0;
+  std::vector<unsigned char> rgb;  ///< width x height x 3
+  bool isLineColour(int x, int y) const {
+    // gnuplot's first line colour, dark violet (148, 0, 211), and its
+    // anti-aliased edge: red and blue well above green.
+    const unsigned char* p = &rgb[3 * (std::size_t(y) * width + x)];
+    return p[2] > 120 && p[0] > 80 && p[1] < 80;
+  }
+  /// Line-colour pixels in [x0, x1) x [y0, y1).
+  int count(int x0, int y0, int x1, int y1) const {
+    int n = 0;
+    for (int y = y0; y < y1; ++y)
+      for (int x = x0; x < x1; ++x) n += isLineColour(x, y);
+    return n;
+  }
+};
+
+std::uint32_t be32(const unsigned char* p) { return (std::uint32_t(p[0]) << 24) | (p[1] << 16) | (p[2] << 8) | p[3]; }
+
+/// Reads an 8-bit RGB or RGBA, non-interlaced PNG (what pngcairo writes).
+Image readPng(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  const std::vector<unsigned char> f((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  if (f.size() < 8 || f[1] != 'P' || f[2] != 'N' || f[3] != 'G') throw std::runtime_error(path + ": not a PNG");
+  Image im;
+  int channels = 0;
+  std::vector<unsigned char> idat;
+  for (std::size_t i = 8; i + 8 <= f.size();) {
+    const std::uint32_t len = be32(&f[i]);
+    const std::string type(f.begin() + i + 4, f.begin() + i + 8);
+    const unsigned char* d = &f[i + 8];
+    if (type == "IHDR") {
+      im.width = int(be32(d)), im.height = int(be32(d + 4));
+      if (d[8] != 8 || d[12] != 0 || (d[9] != 2 && d[9] != 6)) throw std::runtime_error(path + ": unsupported PNG");
+      channels = d[9] == 2 ? 3 : 4;
+    } else if (type == "IDAT") {
+      idat.insert(idat.end(), d, d + len);
+    }
+    i += 12 + len;
+  }
+  const std::size_t stride = std::size_t(im.width) * channels;
+  std::vector<unsigned char> raw((stride + 1) * im.height);
+  uLongf n = raw.size();
+  if (uncompress(raw.data(), &n, idat.data(), idat.size()) != Z_OK || n != raw.size())
+    throw std::runtime_error(path + ": bad image data");
+  std::vector<unsigned char> cur(stride), prev(stride, 0);
+  im.rgb.resize(std::size_t(im.width) * im.height * 3);
+  for (int y = 0; y < im.height; ++y) {
+    const unsigned char filter = raw[y * (stride + 1)];
+    const unsigned char* r = &raw[y * (stride + 1) + 1];
+    for (std::size_t x = 0; x < stride; ++x) {
+      const int a = x >= std::size_t(channels) ? cur[x - channels] : 0, b = prev[x],
+                c = x >= std::size_t(channels) ? prev[x - channels] : 0;
+      int v = r[x];
+      switch (filter) {
+        case 1: v += a; break;
+        case 2: v += b; break;
+        case 3: v += (a + b) / 2; break;
+        case 4: {
+          const int p = a + b - c, pa = std::abs(p - a), pb = std::abs(p - b), pc = std::abs(p - c);
+          v += (pa <= pb && pa <= pc) ? a : (pb <= pc ? b : c);
+          break;
+        }
+        default: break;
+      }
+      cur[x] = static_cast<unsigned char>(v);
+    }
+    for (int x = 0; x < im.width; ++x)
+      for (int k = 0; k < 3; ++k) im.rgb[3 * (std::size_t(y) * im.width + x) + k] = cur[std::size_t(x) * channels + k];
+    prev.swap(cur);
+  }
+  return im;
+}
+
+/// Line-colour pixels of each cell of a rows x cols grid below a title band.
+std::vector<int> panelCounts(const Image& im, int rows, int cols, int titleBand = 50) {
+  std::vector<int> n;
+  const int h = (im.height - titleBand) / rows, w = im.width / cols;
+  for (int r = 0; r < rows; ++r)
+    for (int c = 0; c < cols; ++c) n.push_back(im.count(c * w, titleBand + r * h, (c + 1) * w, titleBand + (r + 1) * h));
+  return n;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream in(path);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+fs::path outDir(const std::string& name) {
+  const fs::path d = fs::path(VDYN_TEST_OUT_DIR) / "plot" / name;
+  fs::remove_all(d);
+  fs::create_directories(d);
+  return d;
+}
+
+void writeTable(const fs::path& dir, const std::string& name, const Table& t) {
+  t.writeCsv((dir / (name + ".csv")).string());
+}
+
+}  // namespace
+
+TEST(Plot, UnitsFromColumnNames) {
+  EXPECT_EQ(unitOfColumn("chassis.yaw_rate_rad_s"), "rad/s");
+  EXPECT_EQ(unitOfColumn("chassis.lateral_accel_m_s2"), "m/s^2");
+  EXPECT_EQ(unitOfColumn("tire_lf.Fz_N"), "N");
+  EXPECT_EQ(unitOfColumn("tire_lf.Mz_N_m"), "N m");
+  EXPECT_EQ(unitOfColumn("t_s"), "s");
+  EXPECT_EQ(unitOfColumn("understeer_gradient_deg_per_m_s2"), "deg/(m/s^2)");
+  EXPECT_EQ(unitOfColumn("stable"), "");
+}
+
+// A table of 20 outputs in five groups: every column is drawn once, on
+// pages of at most 9 panels that keep a group together where it fits, and
+// each panel has its curve.
+TEST(Plot, EveryColumnOnPagesGroupedByPlugin) {
+  if (!gnuplotAvailable()) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path dir = outDir("pages");
+  Table t;
+  t.columns = {"t_s"};
+  const std::vector<std::pair<std::string, int>> groups = {
+      {"chassis", 6}, {"tire_lf", 4}, {"tire_rf", 4}, {"speed_hold", 1}, {"path", 5}};
+  for (const auto& [g, n] : groups)
+    for (int k = 0; k < n; ++k) t.columns.push_back(g + ".q" + std::to_string(k) + "_m");
+  for (int i = 0; i < 200; ++i) {
+    std::vector<double> row = {0.01 * i};
+    for (std::size_t c = 1; c < t.columns.size(); ++c) row.push_back(std::sin(0.05 * i + double(c)));
+    t.rows.push_back(row);
+  }
+  writeTable(dir, "history", t);
+  const auto pngs = renderPlots(dir.string(), {{"history", t}}, {}, 9);
+  // chassis (6) | tire_lf (4) + tire_rf (4) + speed_hold (1) | path (5)
+  ASSERT_EQ(pngs.size(), 3u);
+  EXPECT_EQ(fs::path(pngs[0]).filename(), "history.png");
+  EXPECT_EQ(fs::path(pngs[1]).filename(), "history_2.png");
+  EXPECT_EQ(fs::path(pngs[2]).filename(), "history_3.png");
+  std::multiset<std::string> drawn;
+  for (const auto& png : pngs) {
+    const std::string gp = slurp(png + ".gp");
+    for (std::size_t c = 1; c < t.columns.size(); ++c)
+      if (gp.find("(column(\"" + t.columns[c] + "\"))") != std::string::npos) drawn.insert(t.columns[c]);
+  }
+  for (std::size_t c = 1; c < t.columns.size(); ++c) EXPECT_EQ(drawn.count(t.columns[c]), 1u) << t.columns[c];
+  // Page 2: 9 panels in 3 x 3, each with its curve.
+  const Image im = readPng(pngs[1]);
+  EXPECT_EQ(im.width, 3 * 520);
+  EXPECT_EQ(im.height, 3 * 380 + 50);
+  const auto n = panelCounts(im, 3, 3);
+  for (std::size_t k = 0; k < n.size(); ++k) EXPECT_GT(n[k], 200) << "panel " << k << " of history_2.png";
+  EXPECT_NE(slurp(pngs[1] + ".gp").find("page 2 of 3: tire_lf tire_rf speed_hold"), std::string::npos);
+}
+
+// A yaw angle wrapped to +-pi that grows to 4 pi: drawn unwrapped, its curve
+// reaches the band (2 pi + 1, 4 pi) where the wrapped values never are; the
+// same column without unwrapping leaves that band empty (control).
+TEST(Plot, WrappedAngleIsDrawnUnwrapped) {
+  if (!gnuplotAvailable()) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path dir = outDir("unwrap");
+  Table t;
+  t.columns = {"t_s", "chassis.yaw_rad"};
+  for (int i = 0; i <= 400; ++i) {
+    const double yaw = 4 * M_PI * i / 400.0;
+    t.rows.push_back({0.01 * i, std::remainder(yaw, 2 * M_PI)});
+  }
+  writeTable(dir, "history", t);
+  const auto pngs = renderPlots(dir.string(), {{"history", t}}, {});
+  ASSERT_EQ(pngs.size(), 1u);
+  EXPECT_NE(slurp(pngs[0] + ".gp").find("chassis.yaw_rad (unwrapped)"), std::string::npos);
+  auto bandFigure = [&](bool unwrap) {
+    PlotSpec f;
+    f.name = unwrap ? "unwrapped_band" : "wrapped_band";
+    PlotSpec p;
+    p.title = "yaw in (2 pi + 1, 4 pi)";
+    PlotSeries s{"history", "t_s", "chassis.yaw_rad", ""};
+    s.unwrap = unwrap;
+    p.series = {s};
+    p.y_min = 2 * M_PI + 1, p.y_max = 4 * M_PI;
+    f.panels = {p};
+    return f;
+  };
+  const auto b = renderPlots(dir.string(), {{"history", t}}, {bandFigure(true), bandFigure(false)});
+  ASSERT_EQ(b.size(), 2u);
+  EXPECT_GT(panelCounts(readPng(b[0]), 1, 1)[0], 200);
+  EXPECT_EQ(panelCounts(readPng(b[1]), 1, 1)[0], 0);
+}
+
+// `vdyn run` of ISO 7401 and ISO 4138 on the bicycle: the Bode figure on a
+// logarithmic frequency axis with four drawn panels, and ISO 4138's eight
+// panels with the limit marked and drawn up to it.
+TEST(Plot, HandlingFiguresOfVdynRun) {
+  if (!gnuplotAvailable()) GTEST_SKIP() << "gnuplot not installed";
+  const fs::path dir = outDir("handling");
+  for (const std::string scene : {"iso7401_bicycle", "iso4138_bicycle"}) {
+    const std::string cmd = std::string(VDYN_BIN) + " run " + VDYN_DATA_DIR + "/scenes/" + scene + ".json --out " +
+                            (dir / scene).string() + " > " + (dir / (scene + ".log")).string() + " 2>&1";
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp((dir / (scene + ".log")).string());
+  }
+  const std::string bode = (dir / "iso7401_bicycle" / "frequency_response.png").string();
+  const std::string gp = slurp(bode + ".gp");
+  std::size_t logs = 0;
+  for (std::size_t at = gp.find("set logscale x"); at != std::string::npos; at = gp.find("set logscale x", at + 1)) ++logs;
+  EXPECT_EQ(logs, 4u);
+  EXPECT_NE(gp.find("\"1 Hz\""), std::string::npos);
+  for (int n : panelCounts(readPng(bode), 2, 2)) EXPECT_GT(n, 100);
+  const std::string iso = (dir / "iso4138_bicycle" / "iso4138.png").string();
+  EXPECT_NE(slurp(iso + ".gp").find("\"limit "), std::string::npos);
+  const auto n = panelCounts(readPng(iso), 3, 3);
+  for (int k = 0; k < 8; ++k) EXPECT_GT(n[std::size_t(k)], 50) << "panel " << k << " of iso4138.png";
+  EXPECT_EQ(n[8], 0);  // the ninth cell of the grid is empty
+}
