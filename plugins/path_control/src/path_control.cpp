@@ -63,7 +63,7 @@ const FieldTable<PathFeedforwardParams>& PathFeedforwardParams::fields() {
                   "\"front_cornering_stiffness_N_per_rad\": 1.4e5, \"rear_cornering_stiffness_N_per_rad\": 1.4e5}")
           .number("feedforward_preview_s", &P::preview_s, "s",
                   "T_ff: the curvature is read at the path point of p + v T_ff")
-          .number("feedforward_lag_s", &P::lag_s, "s", "tau_ff of the first-order filter on delta_ss")
+          .number("feedforward_lag_s", &P::lag_s, "s", "tau_ff of each of the two first-order stages filtering delta_ss")
           .string("feedforward_rear_steering", &P::rear_steering,
                   "steering plugin whose angle is delta_r (4WS rear); \"\": none (2WS)");
   return t;
@@ -126,9 +126,9 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
   const double rear = ff_.enabled() && rear_ ? rear_->getAngle(s) : 0.0;
   if (ff_.enabled()) {
     // The prediction (7.13)-(7.16) takes the turn the feed-forward is about to
-    // steer: x'' plus U^2 (kappa_ahead - kappa_f) normal to v, kappa_f the
-    // curvature of the steer already fed forward (f - delta_r) / (l + K U^2).
-    // In a steady turn the two curvatures agree and x'' is the seed's.
+    // steer (header): x'' plus U^2 (kappa_g - kappa_f) normal to v, the
+    // curvatures of the two filter stages (g - delta_r) / (l + K U^2), ...;
+    // in a steady turn they agree and x'' is the seed's.
     const double U = e.v_G.norm();
     e.feedforward_rad = filtered_.getValue(s);
     if (U > 0) {
@@ -205,9 +205,10 @@ class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
       : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
 };
 
-/// The filtered feed-forward f of the header: a z variable with
-/// f' = (delta_ss - f) / tau_ff, delta_ss from calcFeedforwardTarget on the
-/// tracked point's position and velocity (and the rear angle). Value read
+/// One stage of the feed-forward's filter (header): a z variable with
+/// z' = (input - z) / tau_ff, the input the first stage's value g (second
+/// stage, f) or delta_ss from calcFeedforwardTarget on the tracked point's
+/// position and velocity and the rear angle (first stage, g). Value read
 /// from z as the lagged acceleration's; the derivative set while the force
 /// subsystem realizes Acceleration (the inputs need only Stage::Velocity).
 class FeedforwardFilterMeasure : public SimTK::Measure_<SimTK::Real> {

@@ -32,11 +32,19 @@
 // kappa the path's curvature at the point previewed T_ff ahead along the
 // velocity, U = |v|, K = M / l (b / C_af - a / C_ar) the understeer gradient
 // (s^2/m), delta_r the measured rear angle (0 without a rear steering). It
-// enters through a first-order filter f' = (delta_ss - f) / tau_ff (one z
-// variable: a curvature step has no finite rate) and the artificial damper:
+// enters through two first-order stages (two z variables; a critically damped
+// second-order filter: a curvature step has no finite rate)
+//     g' = (delta_ss - g) / tau_ff,   f' = (g - f) / tau_ff
+// and the artificial damper:
 //     delta'' = -(K1 e1 + K2 e2 + K3 e3 + K4 e4) - K5 (delta' - f')    (7.17)-(7.18) + feed-forward
 // so delta follows f (with the lag 1/K5) while the errors' integral holds only
 // what the feed-forward misses; in a steady turn the errors still go to zero.
+// The prediction (7.13)-(7.16) is told of the turn being fed forward: x'' there
+// is the lagged measurement plus U^2 (kappa_g - kappa_f) normal to v, with
+// kappa_g, kappa_f the curvatures of g and f ((g - delta_r) / (l + K U^2)).
+// Without it the look-ahead errors e3, e4 see the coming circle as well and
+// the feedback turns in on top of the feed-forward (j1: 0.16 m off the path,
+// worse than the seed's law); in a steady turn g = f and x'' is the seed's.
 // "none" is the seed's law unchanged.
 #include <memory>
 #include <string>
@@ -90,7 +98,7 @@ struct PathFeedforwardParams {
   bool has_linear_bicycle = false;
   /// T_ff: how far ahead along the velocity the curvature is read, s (>= 0).
   double preview_s = 0.3;
-  /// tau_ff of the filter on delta_ss, s (> 0).
+  /// tau_ff of each of the two filter stages on delta_ss, s (> 0).
   double lag_s = 0.1;
   /// Steering plugin whose angle is delta_r (a 4WS rear axle); "" for none (2WS).
   std::string rear_steering;
