@@ -50,6 +50,23 @@ struct RunResult {
   Json summary;
 };
 
+/// The closed loop's damping in the turn of a J-turn: the log decrement
+/// (calcSwingDecay) of the front angle's half-swings above 1e-4 deg between
+/// the circle's entry (the first sample whose chassis point refers to the arc)
+/// and 1 s before its exit (the look-ahead sees the exit earlier).
+SwingDecay calcTurnDamping(const Scenario& sc, const Recorder& rec) {
+  const auto& t = rec.time();
+  const auto &x = rec.column("chassis.x_m"), &y = rec.column("chassis.y_m");
+  double t0 = -1, t1 = -1;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (sc.path->calcReferencePoint(SimTK::Vec2(x[i], y[i])).curvature_per_m != 0) {
+      if (t0 < 0) t0 = t[i];
+      t1 = t[i];
+    }
+  if (t0 < 0) return {};
+  return calcSwingDecay(t, rec.column("front_steer.angle_rad"), t0, t1 - 1.0, 1e-4 / kDeg);
+}
+
 RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::string& strategyName,
                  const SimulationSettings& baseSim, const std::string& out, bool showProgress) {
   RunResult r;
@@ -80,7 +97,8 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                   "rear_steer.angle_rad", "rear_steer.command_rad", "rear_steer.drift_rad", "rear_control.kr",
                   "rear_control.target_rad", "rear_control.tracking_error_rad", "path_control.e1_m",
                   "path_control.e2", "path_control.e3_m", "path_control.e4", "path_control.path_distance_m",
-                  "path_control.lateral_acceleration_m_s2"});
+                  "path_control.lateral_acceleration_m_s2", "path_control.feedforward_rad",
+                  "path_control.feedforward_target_rad"});
     // A run that has left the path is stopped (an unstable loop would crawl on
     // with ever smaller steps) and recorded as failed, with the event's time.
     EventLimits limits;
@@ -92,6 +110,15 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                                                                   : std::function<void(const SimTK::State&)>()));
     if (showProgress) study::endProgress();
     rec.writeCsv(r.csv);
+    if (sc.path->type() == "j_turn") {
+      const SwingDecay d = calcTurnDamping(sc, rec);
+      Json amps = Json::array();
+      for (double a : d.amplitudes) amps.push_back(a * kDeg);
+      r.summary["turn_damping"] = {{"method", "log decrement of the front angle's half-swings in the turn"},
+                                   {"half_swings", d.half_swings}, {"half_swings_deg", amps},
+                                   {"zeta", d.half_swings >= 2 ? Json(d.zeta) : Json(nullptr)},
+                                   {"frequency_hz", d.half_swings >= 2 ? Json(d.frequency_hz) : Json(nullptr)}};
+    }
     const study::ErrorStats err = study::calcErrorStats(rec.column("path_control.path_distance_m"));
     const auto& kr = rec.column("rear_control.kr");
     r.summary.update({{"completed", true},
@@ -111,6 +138,7 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                                                        study::maxAbs(rec.column("rear_steer.drift_rad")))},
                       {"max_constraint_error", run.max_constraint_error},
                       {"steps", run.steps},
+                      {"peak_feedforward_deg", study::maxAbs(rec.column("path_control.feedforward_rad")) * kDeg},
                       {"sim_time_s", run.sim_time_s},
                       {"wall_time_s", run.wall_time_s}});
   } catch (const std::exception& e) {
@@ -186,6 +214,9 @@ int main(int argc, char** argv) {
         "'half' (each half, h; Figure 8.1 is lost); default: the data file's lane_change_length")(
         "threads", po::value<int>()->default_value(0),
         "worker threads for the runs (0: one per core); the outputs do not depend on it")(
+        "feedforward", po::value<std::string>(),
+        "path_control's steer feed-forward: linear_bicycle (the scene's) or none (the seed's law (7.17)-(7.18) "
+        "alone; docs/path_feedforward.md)")(
         "no-plots", "skip the PNG plots");
     study::addIntegratorOptions(opts);
     const auto vm = study::parse("ch8_maneuvers",
@@ -206,11 +237,17 @@ int main(int argc, char** argv) {
     base.integrator = IntegratorSettings::fromParams(data.child("integrator"));
     study::applyIntegratorOptions(vm, base.integrator);
     base.integrator.validate();
-    const SceneDescription scene = SceneDescription::fromFile(
-        "scenes/ch8_maneuvers.json", registry,
-        {{"vehicle.data", vehicleData},
-         {"plugins.rear_control.kr_table", resolveDataPath(tablePath)},
-         {"plugins.rear_control.linear_bicycle", data.child("linear_bicycle").json()}});
+    std::vector<Override> sceneOverrides = {{"vehicle.data", vehicleData},
+                                {"plugins.rear_control.kr_table", resolveDataPath(tablePath)},
+                                {"plugins.rear_control.linear_bicycle", data.child("linear_bicycle").json()},
+                                {"plugins.path_control.linear_bicycle", data.child("linear_bicycle").json()}};
+    if (vm.count("feedforward"))
+      sceneOverrides.push_back({"plugins.path_control.feedforward", vm["feedforward"].as<std::string>()});
+    const SceneDescription scene = SceneDescription::fromFile("scenes/ch8_maneuvers.json", registry, sceneOverrides);
+    std::string feedforward = "none";  // as the scene (and --feedforward) set it
+    for (const Json& p : scene.json().at("plugins"))
+      if (p.value("name", "") == "path_control") feedforward = p.value("feedforward", feedforward);
+
 
     const std::string reading = vm.count("lane-change-length") ? vm["lane-change-length"].as<std::string>()
                                                                  : data.stringOr("lane_change_length", "full");
@@ -232,8 +269,16 @@ int main(int argc, char** argv) {
         sc.t_end_s += length / sc.speed_m_s;
       }
       sc.path = makeReferencePath(ParamReader::fromJson(sc.path_json, r.at("path")));
-      sc.gains = PathControlParams::fromParams(r.child("gains"));
-      sc.gains_json = r.child("gains").json();
+      // With the seed's law alone (feedforward "none") a scenario may keep its own
+      // gains (gains_feedforward_none: the J-turns' K5 = 30 of before the
+      // feed-forward, so that --feedforward none reproduces those runs). Both read.
+      const char* gainsKey = "gains";
+      if (r.has("gains_feedforward_none")) {
+        PathControlParams::fromParams(r.child("gains_feedforward_none"));
+        if (feedforward == "none") gainsKey = "gains_feedforward_none";
+      }
+      sc.gains = PathControlParams::fromParams(r.child(gainsKey));
+      sc.gains_json = r.child(gainsKey).json();
       for (const PathPoint& pt : sc.path->sample(0, 0, 0.02))
         sc.path_peak_ay = std::max(sc.path_peak_ay, sc.speed_m_s * sc.speed_m_s * std::abs(pt.curvature_per_m));
       sc.rear = r.has("rear_steer_gains") ? RearSteerParams::fromParams(r.child("rear_steer_gains")) : rearDefault;
@@ -331,13 +376,15 @@ int main(int argc, char** argv) {
     }
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
     study::writeJson(out + "/summary.json",
-                     {{"runs", runs}, {"kr_table", tablePath}, {"integrator", base.integrator.method},
+                     {{"runs", runs}, {"feedforward", feedforward}, {"kr_table", tablePath},
+                      {"integrator", base.integrator.method},
                       {"accuracy", base.integrator.accuracy}, {"wall_time_s", wall}, {"threads", threads}});
 
-    std::printf("ch8_maneuvers: 4WS vehicle, %s at %g, Kr table %s\n", base.integrator.method.c_str(),
-                base.integrator.accuracy, tablePath.c_str());
-    std::printf("  %-5s %-9s %6s %12s %10s %10s %9s %9s %13s %15s %7s\n", "scen", "strategy", "U m/s", "peak v_y m/s",
-                "max err m", "rms err m", "front deg", "rear deg", "Kr min..max", "a_y path/car", "wall s");
+    std::printf("ch8_maneuvers: 4WS vehicle, %s at %g, Kr table %s, feedforward %s\n", base.integrator.method.c_str(),
+                base.integrator.accuracy, tablePath.c_str(), feedforward.c_str());
+    std::printf("  %-5s %-9s %6s %12s %10s %10s %9s %9s %13s %15s %7s %s\n", "scen", "strategy", "U m/s", "peak v_y m/s",
+                "max err m", "rms err m", "front deg", "rear deg", "Kr min..max", "a_y path/car", "wall s",
+                "turn zeta (half-swings deg)");
     for (const Json& j : runs) {
       if (!j["completed"].get<bool>()) {
         std::printf("  %-5s %-9s FAILED: %s\n", j["scenario"].get<std::string>().c_str(),
@@ -345,13 +392,30 @@ int main(int argc, char** argv) {
         continue;
       }
       const double me = j["max_path_error_m"].get<double>(), re = j["rms_path_error_m"].get<double>();
-      std::printf("  %-5s %-9s %6.1f %12.4f %10.4f %10.4f %9.3f %9.3f %6.3f..%-6.3f %7.2f/%-7.2f %7.2f%s\n",
+      std::string damping;
+      if (j.contains("turn_damping")) {
+        const Json& d = j["turn_damping"];
+        char buf[64];
+        if (d["zeta"].is_null()) {
+          damping = "no half-swing pair above 1e-4 deg";
+        } else {
+          std::snprintf(buf, sizeof buf, "%.3f (", d["zeta"].get<double>());
+          damping = buf;
+          const Json& a = d["half_swings_deg"];
+          for (std::size_t k = 0; k < a.size() && k < 4; ++k) {
+            std::snprintf(buf, sizeof buf, "%s%.3g", k ? ", " : "", a[k].get<double>());
+            damping += buf;
+          }
+          damping += a.size() > 4 ? ", ...)" : ")";
+        }
+      }
+      std::printf("  %-5s %-9s %6.1f %12.4f %10.4f %10.4f %9.3f %9.3f %6.3f..%-6.3f %7.2f/%-7.2f %7.2f %s%s\n",
                   j["scenario"].get<std::string>().c_str(), j["strategy"].get<std::string>().c_str(),
                   j["speed_m_s"].get<double>(), j["peak_lateral_velocity_m_s"].get<double>(), me, re,
                   j["peak_front_steer_deg"].get<double>(), j["peak_rear_steer_deg"].get<double>(),
                   j["kr_min"].get<double>(), j["kr_max"].get<double>(),
                   j["path_peak_lateral_acceleration_m_s2"].get<double>(),
-                  j["peak_lateral_acceleration_m_s2"].get<double>(), j["wall_time_s"].get<double>(),
+                  j["peak_lateral_acceleration_m_s2"].get<double>(), j["wall_time_s"].get<double>(), damping.c_str(),
                   (me <= 0.10 && re <= 0.03) ? "" : "  (above the 0.10 / 0.03 m bar)");
     }
     std::printf("  total wall time %.1f s; output %s\n", wall, out.c_str());

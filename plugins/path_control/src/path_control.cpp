@@ -23,6 +23,59 @@ void PathControlParams::validate() const {
                 acceleration_estimate + "\"");
 }
 
+void PathFeedforwardParams::validate() const {
+  if (type != "none" && type != "linear_bicycle")
+    throw Error("path control feedforward must be \"none\" or \"linear_bicycle\", got \"" + type + "\"");
+  requireNonNegative(preview_s, "path control feedforward_preview_s");
+  requirePositive(lag_s, "path control feedforward_lag_s");
+  if (type == "linear_bicycle") {
+    if (!has_linear_bicycle)
+      throw Error("path control feedforward \"linear_bicycle\" needs the key linear_bicycle {mass_kg, ...}");
+    linear_bicycle.validate();
+  }
+}
+
+// The linear bicycle's steady turn (chapter 6, (6.5)-(6.6) with beta' = r' = 0,
+// r = U kappa): delta_f - delta_r = (l + K U^2) kappa, the same relation as
+// calcLinearSteadyYawRate's r = U delta_f (1 - Kr) / (l + K U^2) with
+// delta_r = Kr delta_f.
+double PathFeedforwardParams::calcSteadySteer(double kappa, double U, double rear) const {
+  if (type == "none") return 0;
+  return rear + (linear_bicycle.wheelbase_m() + linear_bicycle.understeerGradient() * U * U) * kappa;
+}
+
+const FieldTable<PathFeedforwardParams>& PathFeedforwardParams::fields() {
+  using P = PathFeedforwardParams;
+  static const auto t =
+      FieldTable<P>()
+          .string("feedforward", &P::type,
+                  "steer feed-forward of the path curvature: none (the seed's law (7.17)-(7.18)) | linear_bicycle "
+                  "(delta_r + (l + K U^2) kappa through the K5 damper; docs/path_feedforward.md)")
+          .custom("linear_bicycle", "-", "required for linear_bicycle",
+                  "{mass_kg, front_axle_to_com_m, rear_axle_to_com_m, front_/rear_cornering_stiffness_N_per_rad}: "
+                  "l and K of the feed-forward",
+                  [](const ParamReader& r, P& p) {
+                    if (!r.has("linear_bicycle")) return;
+                    p.linear_bicycle = LinearBicycleParams::fromParams(r.child("linear_bicycle"));
+                    p.has_linear_bicycle = true;
+                  })
+          .sample("{\"mass_kg\": 1024, \"front_axle_to_com_m\": 1.305, \"rear_axle_to_com_m\": 0.965, "
+                  "\"front_cornering_stiffness_N_per_rad\": 1.4e5, \"rear_cornering_stiffness_N_per_rad\": 1.4e5}")
+          .number("feedforward_preview_s", &P::preview_s, "s",
+                  "T_ff: the curvature is read at the path point of p + v T_ff")
+          .number("feedforward_lag_s", &P::lag_s, "s", "tau_ff of each of the two first-order stages filtering delta_ss")
+          .string("feedforward_rear_steering", &P::rear_steering,
+                  "steering plugin whose angle is delta_r (4WS rear); \"\": none (2WS)");
+  return t;
+}
+
+double calcFeedforwardTarget(const PathFeedforwardParams& ff, const ReferencePath& path, const Vec2& p_G,
+                             const Vec2& v_G, double rear_rad) {
+  if (!ff.enabled()) return 0;
+  const PathPoint ahead = path.calcReferencePoint(p_G + v_G * ff.preview_s);
+  return ff.calcSteadySteer(ahead.curvature_per_m, v_G.norm(), rear_rad);
+}
+
 namespace {
 const FieldTable<PathControlParams>& gainFields() {
   using P = PathControlParams;
@@ -50,10 +103,14 @@ PathControlParams PathControlParams::fromParams(const ParamReader& r) {
 // ---------------------------------------------------------------------------
 PathController::PathController(std::string name, const PathControlParams& params,
                                std::shared_ptr<const ReferencePath> path, const SimTK::MobilizedBody& chassis,
-                               const SteeringActuator& steer, SimTK::Measure ax, SimTK::Measure ay)
+                               const SteeringActuator& steer, SimTK::Measure ax, SimTK::Measure ay,
+                               const PathFeedforwardParams& feedforward, const SteeringActuator* rear,
+                               SimTK::Measure stage1, SimTK::Measure filtered)
     : SteeringLaw(std::move(name)), p_(params), path_(std::move(path)), chassis_(chassis), steer_(&steer), ax_(ax),
-      ay_(ay) {
+      ay_(ay), ff_(feedforward), rear_(rear), stage1_(stage1), filtered_(filtered) {
   p_.validate();
+  ff_.validate();
+  assert(!ff_.enabled() || !filtered_.isEmptyHandle());
   if (!path_) throw Error("path controller '" + this->name() + "': no path");
   assert(p_.acceleration_estimate != "lagged" || (!ax_.isEmptyHandle() && !ay_.isEmptyHandle()));
   lagged_ = p_.acceleration_estimate == "lagged";
@@ -66,6 +123,20 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
   e.p_G = Vec2(p[0], p[1]);
   e.v_G = Vec2(v[0], v[1]);
   e.a_G = lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0);
+  const double rear = ff_.enabled() && rear_ ? rear_->getAngle(s) : 0.0;
+  if (ff_.enabled()) {
+    // The prediction (7.13)-(7.16) takes the turn the feed-forward is about to
+    // steer (header): x'' plus U^2 (kappa_g - kappa_f) normal to v, the
+    // curvatures of the two filter stages (g - delta_r) / (l + K U^2), ...;
+    // in a steady turn they agree and x'' is the seed's.
+    const double U = e.v_G.norm();
+    e.feedforward_rad = filtered_.getValue(s);
+    if (U > 0) {
+      const double gain = ff_.calcSteadySteer(1.0, U, 0.0);  // l + K U^2, rad per 1/m
+      const double kG = (stage1_.getValue(s) - rear) / gain, kF = (e.feedforward_rad - rear) / gain;
+      e.a_G += U * U * (kG - kF) * Vec2(-e.v_G[1], e.v_G[0]) / U;
+    }
+  }
   const double dT = p_.look_ahead_s;
   e.p_ahead_G = e.p_G + e.v_G * dT + e.a_G * (dT * dT / 2);  // (7.13)-(7.14)
   e.v_ahead_G = e.v_G + e.a_G * dT;                           // (7.15)-(7.16)
@@ -76,6 +147,12 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
   e.accel_rad_s2 = -(p_.k1_rad_per_s2_per_m * e.now.position_m + p_.k2_rad_per_s2 * e.now.slope +
                      p_.k3_rad_per_s2_per_m * e.ahead.position_m + p_.k4_rad_per_s2 * e.ahead.slope) -
                    p_.k5_per_s * e.steer_rate_rad_s;
+  if (ff_.enabled()) {
+    // The feed-forward through the damper: -K5 (delta' - f') (header, docs/path_feedforward.md).
+    e.feedforward_target_rad = calcFeedforwardTarget(ff_, *path_, e.p_G, e.v_G, rear);
+    e.feedforward_rate_rad_s = (stage1_.getValue(s) - e.feedforward_rad) / ff_.lag_s;
+    e.accel_rad_s2 += p_.k5_per_s * e.feedforward_rate_rad_s;
+  }
   return e;
 }
 
@@ -128,6 +205,65 @@ class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
       : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
 };
 
+/// One stage of the feed-forward's filter (header): a z variable with
+/// z' = (input - z) / tau_ff, the input the first stage's value g (second
+/// stage, f) or delta_ss from calcFeedforwardTarget on the tracked point's
+/// position and velocity and the rear angle (first stage, g). Value read
+/// from z as the lagged acceleration's; the derivative set while the force
+/// subsystem realizes Acceleration (the inputs need only Stage::Velocity).
+class FeedforwardFilterMeasure : public SimTK::Measure_<SimTK::Real> {
+ public:
+  class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
+   public:
+    Implementation(const SimTK::MobilizedBody& body, const Vec3& station, std::shared_ptr<const ReferencePath> path,
+                   const PathFeedforwardParams& ff, const SteeringActuator* rear, SimTK::Measure input)
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0),
+          input_(input),
+          matter_(&body.getMatterSubsystem()),
+          body_(body.getMobilizedBodyIndex()),
+          station_(station),
+          path_(std::move(path)),
+          ff_(ff),
+          rear_(rear) {}
+    Implementation* cloneVirtual() const override { return new Implementation(*this); }
+    int getNumTimeDerivativesVirtual() const override { return 0; }
+    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
+    const SimTK::Real& getUncachedValueVirtual(const SimTK::State& s, int derivOrder) const override {
+      assert(derivOrder == 0);
+      (void)derivOrder;
+      return getSubsystem().getZ(s)[zIndex_];
+    }
+    void realizeMeasureTopologyVirtual(SimTK::State& s) const override {
+      zIndex_ = getSubsystem().allocateZ(s, SimTK::Vector(1, 0.0));
+    }
+    void initializeVirtual(SimTK::State& s) const override { getSubsystem().updZ(s)[zIndex_] = 0; }
+    void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
+      double target = 0;
+      if (!input_.isEmptyHandle()) {
+        target = input_.getValue(s);
+      } else {
+        const SimTK::MobilizedBody& b = matter_->getMobilizedBody(body_);
+        const Vec3 p = b.findStationLocationInGround(s, station_), v = b.findStationVelocityInGround(s, station_);
+        target =
+            calcFeedforwardTarget(ff_, *path_, Vec2(p[0], p[1]), Vec2(v[0], v[1]), rear_ ? rear_->getAngle(s) : 0.0);
+      }
+      getSubsystem().updZDot(s)[zIndex_] = (target - getSubsystem().getZ(s)[zIndex_]) / ff_.lag_s;
+    }
+
+   private:
+    SimTK::Measure input_;  // the first stage's value (second stage), or empty: delta_ss
+    const SimTK::SimbodyMatterSubsystem* matter_;  // the body by index (see LaggedAccelerationMeasure)
+    SimTK::MobilizedBodyIndex body_;
+    Vec3 station_;
+    std::shared_ptr<const ReferencePath> path_;
+    PathFeedforwardParams ff_;
+    const SteeringActuator* rear_;  // owned by the same scene
+    mutable SimTK::ZIndex zIndex_;
+  };
+  FeedforwardFilterMeasure(SimTK::Subsystem& sub, Implementation* impl)
+      : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
+};
+
 SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, const Vec3& station, int axis,
                                      double tau) {
   return LaggedAccelerationMeasure(scene.updForces(),
@@ -136,13 +272,16 @@ SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& c
 }  // namespace
 
 PathControlPlugin::PathControlPlugin(std::string name, std::string steeringPlugin, std::string chassisBody,
-                                     std::shared_ptr<const ReferencePath> path, const PathControlParams& params)
+                                     std::shared_ptr<const ReferencePath> path, const PathControlParams& params,
+                                     const PathFeedforwardParams& feedforward)
     : ControllerPlugin("path_control", std::move(name)),
       steering_(std::move(steeringPlugin)),
       chassis_(std::move(chassisBody)),
       path_(std::move(path)),
-      p_(params) {
+      p_(params),
+      ff_(feedforward) {
   p_.validate();
+  ff_.validate();
   if (!path_) throw Error("path control plugin '" + this->name() + "': no path");
 }
 
@@ -163,7 +302,23 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
     ax = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 0, p_.acceleration_lag_s);
     ay = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 1, p_.acceleration_lag_s);
   }
-  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, *steer, ax, ay);
+  const SteeringActuator* rear = nullptr;
+  SimTK::Measure stage1, filtered;
+  if (ff_.enabled()) {
+    if (!ff_.rear_steering.empty()) {
+      rear = scene.findPlugin<SteeringActuator>(ff_.rear_steering);
+      if (!rear)
+        throw Error("path control plugin '" + name() + "': feedforward_rear_steering: the scene has no steering plugin '" +
+                    ff_.rear_steering + "'");
+    }
+    // Two first-order stages g, f (a critically damped second-order filter):
+    // f' = (g - f) / tau_ff is continuous where delta_ss steps.
+    stage1 = FeedforwardFilterMeasure(scene.updForces(), new FeedforwardFilterMeasure::Implementation(
+                                                             chassis, p_.tracked_point_m, path_, ff_, rear, {}));
+    filtered = FeedforwardFilterMeasure(scene.updForces(), new FeedforwardFilterMeasure::Implementation(
+                                                               chassis, p_.tracked_point_m, path_, ff_, rear, stage1));
+  }
+  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, *steer, ax, ay, ff_, rear, stage1, filtered);
   steer->setAccelerationLaw(law_);
   const auto law = law_;
   auto add = [&](const std::string& key, const std::string& unit, auto f) {
@@ -174,6 +329,8 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   add("e2", "1", [](const PathControlEvaluation& e) { return e.now.slope; });
   add("e3_m", "m", [](const PathControlEvaluation& e) { return e.ahead.position_m; });
   add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
+  add("feedforward_rad", "rad", [](const PathControlEvaluation& e) { return e.feedforward_rad; });
+  add("feedforward_target_rad", "rad", [](const PathControlEvaluation& e) { return e.feedforward_target_rad; });
   // The estimated acceleration's component normal to the velocity (+ left).
   add("lateral_acceleration_m_s2", "m/s^2", [](const PathControlEvaluation& e) {
     const double v = e.v_G.norm();
@@ -194,6 +351,7 @@ struct PathControlEntry {
   std::string steering, chassis;
   std::shared_ptr<const ReferencePath> path;
   PathControlParams gains;
+  PathFeedforwardParams feedforward;
 };
 const FieldTable<PathControlEntry>& pathControlFields() {
   using E = PathControlEntry;
@@ -209,10 +367,33 @@ const FieldTable<PathControlEntry>& pathControlFields() {
                   "reference path {type: lane_change (7.6)-(7.8) | j_turn (7.19)-(7.24) | double_lane_change, ...}",
                   [](const ParamReader& r, E& e) { e.path = makeReferencePath(r.child("path")); })
           .sample("{\"type\": \"lane_change\", \"length_m\": 30, \"shift_m\": 3}")
-          .object("gains", &E::gains, gainFields(), "gains and look-ahead", true);
+          .object("gains", &E::gains, gainFields(), "gains and look-ahead", true)
+          .include(&E::feedforward, PathFeedforwardParams::fields());
   return t;
 }
 }  // namespace
+
+SwingDecay calcSwingDecay(const std::vector<double>& t, const std::vector<double>& x, double t0, double t1,
+                          double floor) {
+  if (t.size() != x.size()) throw Error("calcSwingDecay: time and value columns differ in length");
+  std::vector<double> ext, tExt;
+  for (std::size_t i = 1; i + 1 < x.size(); ++i)
+    if (t[i] >= t0 && t[i] <= t1 && (x[i] - x[i - 1]) * (x[i + 1] - x[i]) < 0) ext.push_back(x[i]), tExt.push_back(t[i]);
+  SwingDecay d;
+  if (!tExt.empty()) d.first_extreme_time_s = tExt.front();
+  for (std::size_t k = 0; k + 1 < ext.size(); ++k) {
+    const double a = std::abs(ext[k + 1] - ext[k]);
+    if (a <= floor) break;
+    d.amplitudes.push_back(a);
+  }
+  d.half_swings = int(d.amplitudes.size());
+  if (d.half_swings < 2) return d;
+  const int n = d.half_swings;
+  const double dec = 2 * std::log(d.amplitudes.front() / d.amplitudes.back()) / (n - 1);
+  d.zeta = dec / std::sqrt(4 * SimTK::Pi * SimTK::Pi + dec * dec);
+  d.frequency_hz = 1 / (2 * (tExt[n] - tExt[0]) / n);
+  return d;
+}
 
 void registerPathControlPlugins(PluginRegistry& registry) {
   registry.add(
@@ -220,10 +401,16 @@ void registerPathControlPlugins(PluginRegistry& registry) {
       [](const PluginSpec& spec) -> std::unique_ptr<Plugin> {
         PathControlEntry e = pathControlFields().read(spec.params);
         e.gains.validate();
+        try {
+          e.feedforward.validate();
+        } catch (const Error& err) {
+          throw Error(spec.params.where() + ": " + err.what());
+        }
         return std::make_unique<PathControlPlugin>(spec.name, spec.bound("steering"), spec.bound("chassis"), e.path,
-                                                   e.gains);
+                                                   e.gains, e.feedforward);
       },
-      typeInfo("path-following steering law (7.9)-(7.18) with look-ahead; outputs <name>.e1_m, ...",
+      typeInfo("path-following steering law (7.9)-(7.18) with look-ahead, optional curvature feed-forward; outputs "
+               "<name>.e1_m, ...",
                pathControlFields()));
 }
 

@@ -20,8 +20,35 @@
 // delta -> tire force -> e3 -> delta''. Estimating x'' from the yaw rate,
 // r (-y', x'), loses that term, and the seed's gains then oscillate (measured
 // on the bicycle); so does a lag tau of 0.02 s or more.
+//
+// Feed-forward (an option, "feedforward"; docs/path_feedforward.md). The law
+// above holds the steer angle a turn needs by integrating the errors: with
+// delta' = 0 in a steady turn, K5 delta = -integral of (K1 e1 + ... + K4 e4),
+// so every curvature change is first an error. "linear_bicycle" adds the
+// steer the path's curvature needs in a steady turn, from the linear bicycle
+// (chapter 6, (6.5)-(6.7) with beta' = r' = 0; Gillespie, "Fundamentals of
+// Vehicle Dynamics", eq. 6-13 with the rear angle):
+//     delta_ss = delta_r + (l + K U^2) kappa(p + v T_ff),
+// kappa the path's curvature at the point previewed T_ff ahead along the
+// velocity, U = |v|, K = M / l (b / C_af - a / C_ar) the understeer gradient
+// (s^2/m), delta_r the measured rear angle (0 without a rear steering). It
+// enters through two first-order stages (two z variables; a critically damped
+// second-order filter: a curvature step has no finite rate)
+//     g' = (delta_ss - g) / tau_ff,   f' = (g - f) / tau_ff
+// and the artificial damper:
+//     delta'' = -(K1 e1 + K2 e2 + K3 e3 + K4 e4) - K5 (delta' - f')    (7.17)-(7.18) + feed-forward
+// so delta follows f (with the lag 1/K5) while the errors' integral holds only
+// what the feed-forward misses; in a steady turn the errors still go to zero.
+// The prediction (7.13)-(7.16) is told of the turn being fed forward: x'' there
+// is the lagged measurement plus U^2 (kappa_g - kappa_f) normal to v, with
+// kappa_g, kappa_f the curvatures of g and f ((g - delta_r) / (l + K U^2)).
+// Without it the look-ahead errors e3, e4 see the coming circle as well and
+// the feedback turns in on top of the feed-forward (j1: 0.16 m off the path,
+// worse than the seed's law); in a steady turn g = f and x'' is the seed's.
+// "none" is the seed's law unchanged.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <Simbody.h>
 
@@ -29,6 +56,7 @@
 #include "vdyn/core/scene.h"
 #include "vdyn/core/steering_actuator.h"
 #include "vdyn/path/path.h"
+#include "vdyn/steering_ratio/linear_ratio.h"
 
 namespace vdyn {
 
@@ -59,13 +87,41 @@ struct PathControlParams {
   static PathControlParams fromParams(const ParamReader& r);
 };
 
+/// The steer feed-forward of the path's curvature (see above). Plugin-level
+/// keys of "path_control" (not gains: the seed's gains stay as they are).
+struct PathFeedforwardParams {
+  /// "none" (the seed's law (7.17)-(7.18)) or "linear_bicycle".
+  std::string type = "none";
+  /// The linear bicycle whose steady turn gives delta_ss (required for
+  /// "linear_bicycle"; chapter 6's values in the chapter 8 scene).
+  LinearBicycleParams linear_bicycle;
+  bool has_linear_bicycle = false;
+  /// T_ff: how far ahead along the velocity the curvature is read, s (>= 0).
+  double preview_s = 0.3;
+  /// tau_ff of each of the two filter stages on delta_ss, s (> 0).
+  double lag_s = 0.1;
+  /// Steering plugin whose angle is delta_r (a 4WS rear axle); "" for none (2WS).
+  std::string rear_steering;
+
+  bool enabled() const { return type != "none"; }
+  void validate() const;
+  /// delta_ss = delta_r + (l + K U^2) kappa, rad (+ left), for a path
+  /// curvature kappa (1/m, + left), speed U (m/s) and rear angle delta_r (rad).
+  double calcSteadySteer(double curvature_per_m, double speed_m_s, double rear_rad) const;
+  /// The keys (one table: read by the plugin entry, documented by `vdyn list`).
+  static const FieldTable<PathFeedforwardParams>& fields();
+};
+
 /// What the controller sees on a state (Stage::Velocity).
 struct PathControlEvaluation {
   SimTK::Vec2 p_G{0, 0}, v_G{0, 0}, a_G{0, 0};  ///< tracked point's position, velocity, estimated acceleration
   SimTK::Vec2 p_ahead_G{0, 0}, v_ahead_G{0, 0}; ///< predicted at t + dT (7.13)-(7.16)
   PathErrors now, ahead;                ///< (e1, e2) and (e3, e4)
   double steer_rate_rad_s = 0;          ///< delta'
-  double accel_rad_s2 = 0;              ///< delta'' (7.17)-(7.18)
+  double feedforward_target_rad = 0;    ///< delta_ss at the previewed point (0 with no feed-forward)
+  double feedforward_rad = 0;           ///< f, the filtered feed-forward steer
+  double feedforward_rate_rad_s = 0;    ///< f' = (delta_ss - f) / tau_ff
+  double accel_rad_s2 = 0;              ///< delta'' (7.17)-(7.18), plus K5 f' with the feed-forward
 };
 
 /// The law (7.17)-(7.18) on a state-driven steering plugin's acceleration.
@@ -74,11 +130,16 @@ class PathController : public SteeringLaw {
   /// ax_lagged, ay_lagged: the two lagged acceleration measures of the
   /// "lagged" estimate (empty handles otherwise).
   /// `steer` is the state-driven steering the law drives (owned by the same scene).
+  /// With a feed-forward: `feedforward` its parameters, `rear` the rear
+  /// steering (nullptr for none), `filtered` the measure holding f.
   PathController(std::string name, const PathControlParams& params, std::shared_ptr<const ReferencePath> path,
                  const SimTK::MobilizedBody& chassis, const SteeringActuator& steer,
-                 SimTK::Measure ax_lagged, SimTK::Measure ay_lagged);
+                 SimTK::Measure ax_lagged, SimTK::Measure ay_lagged,
+                 const PathFeedforwardParams& feedforward = {}, const SteeringActuator* rear = nullptr,
+                 SimTK::Measure stage1 = {}, SimTK::Measure filtered = {});
   PathControlEvaluation calcEvaluation(const SimTK::State& s) const;
   const PathControlParams& params() const { return p_; }
+  const PathFeedforwardParams& feedforward() const { return ff_; }
   const ReferencePath& path() const { return *path_; }
 
  protected:
@@ -91,17 +152,27 @@ class PathController : public SteeringLaw {
   const SteeringActuator* steer_;  // owned by the same scene
   SimTK::Measure ax_, ay_;
   bool lagged_ = false;
+  PathFeedforwardParams ff_;
+  const SteeringActuator* rear_ = nullptr;  // owned by the same scene
+  SimTK::Measure stage1_, filtered_;
 };
+
+/// delta_ss of the feed-forward for a tracked point at p_G moving with v_G:
+/// the path's curvature at the reference point of p_G + v_G T_ff, at U = |v_G|.
+double calcFeedforwardTarget(const PathFeedforwardParams& ff, const ReferencePath& path, const SimTK::Vec2& p_G,
+                             const SimTK::Vec2& v_G, double rear_rad);
 
 /// Controller plugin: sets a PathController as the law of the named
 /// state-driven steering (any SteeringActuator). Outputs <name>.e1_m, .e2, .e3_m, .e4,
 /// .lateral_acceleration_m_s2 (the estimated x'' normal to the velocity),
 /// .path_distance_m (signed closest-point distance of the tracked point to
-/// the path, the reported path error).
+/// the path, the reported path error), .feedforward_rad (f) and
+/// .feedforward_target_rad (delta_ss; both 0 with no feed-forward).
 class PathControlPlugin : public ControllerPlugin {
  public:
   PathControlPlugin(std::string name, std::string steeringPlugin, std::string chassisBody,
-                    std::shared_ptr<const ReferencePath> path, const PathControlParams& params);
+                    std::shared_ptr<const ReferencePath> path, const PathControlParams& params,
+                    const PathFeedforwardParams& feedforward = {});
   const PathController& controller() const;
   /// Name of the state-driven steering plugin the controller drives.
   const std::string& steeringPlugin() const { return steering_; }
@@ -113,11 +184,28 @@ class PathControlPlugin : public ControllerPlugin {
   std::string steering_, chassis_;
   std::shared_ptr<const ReferencePath> path_;
   PathControlParams p_;
+  PathFeedforwardParams ff_;
   std::shared_ptr<const PathController> law_;
 };
 
+/// The damping of a decaying swing by the logarithmic decrement: the extremes
+/// of x(t) for t in [t0_s, t1_s], the half-swings A_k = |x_{k+1} - x_k|
+/// between successive extremes (a constant offset drops out) while they stay
+/// above floor, d = 2 ln(A_1 / A_n) / (n - 1) per period and
+/// zeta = d / sqrt(4 pi^2 + d^2), the frequency from the mean spacing of the
+/// extremes. `half_swings` < 2: no decrement (no swing above the floor).
+struct SwingDecay {
+  int half_swings = 0;                     ///< n, half-swings above the floor
+  std::vector<double> amplitudes;          ///< A_1 .. A_n (x's unit)
+  double first_extreme_time_s = 0;         ///< time of the first extreme
+  double zeta = 0, frequency_hz = 0;       ///< 0 when half_swings < 2
+};
+SwingDecay calcSwingDecay(const std::vector<double>& t_s, const std::vector<double>& x, double t0_s, double t1_s,
+                          double floor);
+
 /// Registers "path_control": {"steering": "front_steer", "chassis": "chassis",
-/// "path": {...makeReferencePath}, "gains": {...PathControlParams}}.
+/// "path": {...makeReferencePath}, "gains": {...PathControlParams},
+/// "feedforward": "none" | "linear_bicycle", ...PathFeedforwardParams}.
 void registerPathControlPlugins(PluginRegistry& registry);
 
 }  // namespace vdyn
