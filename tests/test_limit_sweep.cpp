@@ -174,10 +174,12 @@ double numberAfter(const std::string& text, const std::string& head) {
 // (the unstable branch), later spinning out. The transient's lateral
 // acceleration along its path, U (r + d beta / dt), where its side slip
 // passes the fold's side slip (the departure) is the fold's lateral
-// acceleration r U within 2 %. (The angle the command has reached then lies
-// 0.2-0.6 deg past the fold's: the delay of a ramped passage through a
-// saddle-node, which grows with the ramp rate; the spin_out event comes
-// seconds later.)
+// acceleration r U within 2 % (measured: +0.58 % at 10 m/s, +0.93 % at 15
+// m/s). The command has then passed the fold's angle by 0.34 deg (10 m/s)
+// and 0.26 deg (15 m/s): the delay of a ramped passage through a
+// saddle-node, which grows with the ramp rate; r U when the command passes
+// the fold's angle is 9 % below the fold's at 15 m/s (a_y(delta) is vertical
+// at a fold), and the spin_out event comes 5-10 s after the departure.
 TEST(LimitSweep, FoldInFrontSteerAgreesWithTheSlowRampSteerDeparture) {
   const SceneDescription steady = SceneDescription::fromFile("scenes/ch3_steady_state.json", standardRegistry());
   const SceneDescription transient = SceneDescription::fromFile("scenes/ch3_transient.json", standardRegistry());
@@ -191,8 +193,9 @@ TEST(LimitSweep, FoldInFrontSteerAgreesWithTheSlowRampSteerDeparture) {
     const double foldDeg = numberAfter(msg, kFoldHead), foldAy = numberAfter(msg, "(lateral acceleration ");
     const double foldTime = numberAfter(msg, "at command time ");
     // The fold's side slip: the branch's state 2e-6 s of command time before
-    // it (the fold is located to 1.5e-7 s; beta differs from the fold's by
-    // about 0.25 sqrt(2e-6) = 4e-4 rad).
+    // it (the fold is located to 1.5e-7 s; beta goes as the square root of
+    // the distance to the fold: within about 1e-3 rad of the fold's, which
+    // moves the departure by about 0.02 s).
     const Json nearFold = runScene(big.withOverride("analysis.time_s", foldTime - 2e-6), noFiles());
     const double foldBeta = nearFold.at("steady").at("chassis.side_slip_rad").get<double>();
     EXPECT_NEAR(nearFold.at("steady").at("chassis.yaw_rate_rad_s").get<double>() * U, foldAy, 0.01 * foldAy);
@@ -207,7 +210,7 @@ TEST(LimitSweep, FoldInFrontSteerAgreesWithTheSlowRampSteerDeparture) {
                             std::to_string(int(U)) + "_" + std::to_string(::getpid());
     RunOptions ro = noFiles();
     ro.out_dir = dir;
-    const double tEnd = 0.5 + foldDeg / rate * 1.15;  // the spin comes within 15 % past the fold's angle
+    const double tEnd = 0.5 + foldDeg / rate + 20;  // the spin comes within 20 s past the fold's angle
     const Json s = runScene(transient.withOverrides(speed).withOverrides(
                                 {{"plugins.front_steer.command", ramp(30, rate)},
                                  {"plugins.rear_steer.command", ramp(7.5, rate / 4)},
@@ -220,11 +223,13 @@ TEST(LimitSweep, FoldInFrontSteerAgreesWithTheSlowRampSteerDeparture) {
                                   {"t_s", "chassis.yaw_rate_rad_s", "chassis.side_slip_rad", "front_steer.command_rad"});
     std::filesystem::remove_all(dir);
     const auto &t = c[0], &r = c[1], &b = c[2], &d = c[3];
-    // The first report interval where beta passes the fold's beta (from the
-    // side it starts on), interpolated linearly.
-    const double sgn = foldBeta - b[2] > 0 ? 1 : -1;
-    std::size_t i = 2;
-    while (i + 1 < t.size() && sgn * (foldBeta - b[i + 1]) > 0) ++i;
+    // From where the command reaches the fold's angle (the side slip has not
+    // yet reached the fold's there: the passage lags), the first report
+    // interval where beta passes the fold's beta, interpolated linearly.
+    std::size_t i = 1;
+    while (i + 1 < t.size() && d[i] < foldDeg * kDeg) ++i;
+    const double sgn = foldBeta - b[i] > 0 ? 1 : -1;
+    while (i + 2 < t.size() && sgn * (foldBeta - b[i + 1]) > 0) ++i;
     ASSERT_LT(i + 2, t.size()) << "the transient's side slip never reaches the fold's";
     auto pathAy = [&](std::size_t k) { return U * (r[k] + (b[k + 1] - b[k - 1]) / (t[k + 1] - t[k - 1])); };
     const double w = (foldBeta - b[i]) / (b[i + 1] - b[i]);
@@ -235,7 +240,7 @@ TEST(LimitSweep, FoldInFrontSteerAgreesWithTheSlowRampSteerDeparture) {
                 U, foldDeg, foldAy, foldBeta, rate, tDep, dDeg, ay, 100 * (ay - foldAy) / foldAy,
                 s.at("events")[0].at("message").get<std::string>().c_str());
     EXPECT_NEAR(ay, foldAy, 0.02 * foldAy);
-    EXPECT_GT(dDeg, foldDeg);  // the ramp passes the fold's angle before it departs
+    EXPECT_LT(dDeg - foldDeg, 1.0);  // the passage's delay, command angle past the fold's (deg)
     EXPECT_GT(s.at("events")[0].at("time_s").get<double>(), tDep);
   }
 }
