@@ -39,7 +39,7 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   // The arclength counts the scaled state's change too (about 40 T along the
   // ch3 turn's branch at 15 m/s): a largest step of T / 4 took 160-170 steps
   // there, T takes 50-55 (2.4x less CPU per steady state, the same state to
-  // 1e-12 and the same fold to its location tolerance).
+  // 1e-10 and the same fold to its location tolerance).
   o.max_step = T;
   o.min_step = 1e-9 * T;
   o.location_tolerance = 1e-7 * T;
