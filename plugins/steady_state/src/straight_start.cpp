@@ -4,6 +4,20 @@
 
 namespace vdyn {
 
+namespace {
+
+/// Yaw rate x horizontal speed of the floating base (m/s^2; 0 without one).
+double lateralOf(const Scene& scene, const SteadyStateSolver& solver, const SimTK::State& state) {
+  if (!solver.problem().floating_base.isValid()) return 0;
+  SimTK::State s = state;
+  scene.getSystem().realize(s, SimTK::Stage::Velocity);
+  const SimTK::MobilizedBody& b = scene.getMatter().getMobilizedBody(solver.problem().floating_base);
+  const SimTK::Vec3 v = b.getBodyOriginVelocity(s);
+  return b.getBodyAngularVelocity(s)[2] * std::hypot(v[0], v[1]);
+}
+
+}  // namespace
+
 SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scene& scene, const SimTK::State& initial,
                                            const std::function<double(const SimTK::State&)>& frontSteer,
                                            StraightStartReport* report) {
@@ -22,7 +36,11 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   }
   ArclengthOptions o;
   o.step = T / 20;
-  o.max_step = T / 4;
+  // The arclength counts the scaled state's change too (about 40 T along the
+  // ch3 turn's branch at 15 m/s): a largest step of T / 4 took 160-170 steps
+  // there, T takes 50-55 (2.4x less CPU per steady state, the same state to
+  // 1e-10 and the same fold to its location tolerance).
+  o.max_step = T;
   o.min_step = 1e-9 * T;
   o.location_tolerance = 1e-7 * T;
   o.lambda_min = -T;
@@ -30,8 +48,38 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   o.max_points = 1000;
   o.stop_after_folds = 1;
   o.points_after_last_fold = 1;
-  const ArclengthResult ar =
-      continueSteadyState(solver, r0, 0.0, [](SimTK::State& s, double t) { s.setTime(t); }, T, false, o);
+  const auto setTime = [](SimTK::State& s, double t) { s.setTime(t); };
+  ArclengthResult ar;
+  try {
+    ar = continueSteadyState(solver, r0, 0.0, setTime, T, false, o);
+  } catch (const Error& e) {
+    // A wheel lifting off puts a kink into the branch (the tire's normal load
+    // reaches zero; past it the wheel hangs): the corrector cannot cross it
+    // and the step falls below min_step there. Named when the branch, followed
+    // again to just before that command time, ends with a tire unloaded.
+    const std::string msg = e.what(), head = "the step fell below min_step", at = "at lambda = ";
+    const auto p = msg.find(at);
+    if (msg.find(head) == std::string::npos || p == std::string::npos) throw;
+    const double stuck = std::stod(msg.substr(p + at.size()));
+    ArclengthOptions ob = o;
+    ob.lambda_max = stuck - 1e-3 * T;
+    const ArclengthResult before = continueSteadyState(solver, r0, 0.0, setTime, T, false, ob);
+    const SteadyStateResult last = solver.makeDrivenResult(before.points.back().x, before.points.back().lambda);
+    std::string tire;
+    double fz = 0, fz0 = 0;
+    for (const auto& n : scene.getOutputNames()) {
+      if (n.size() < 5 || n.compare(n.size() - 5, 5, ".Fz_N") != 0) continue;
+      const double f = scene.evalOutput(n, last.state), f0 = scene.evalOutput(n, r0.state);
+      if (f0 > 0 && f < 0.02 * f0 && (tire.empty() || f / f0 < fz / fz0)) tire = n, fz = f, fz0 = f0;
+    }
+    if (tire.empty()) throw;
+    throw Error("no steady state found on the branch from straight running past a wheel lift-off: " + tire + " = " +
+                formatValue(fz) + " N (" + formatValue(fz0) + " N at straight running) at front steer " +
+                (frontSteer ? formatValue(frontSteer(last.state) * 180 / SimTK::Pi) : std::string("(unknown)")) +
+                " deg (lateral acceleration " + formatValue(lateralOf(scene, solver, last.state)) +
+                " m/s^2), at command time " + formatValue(before.points.back().lambda) + " s of " + formatValue(T) +
+                " s (the continuation does not cross the contact's kink: " + msg + ")");
+  }
   if (report) {
     report->arclength_steps = ar.steps;
     report->rejected_steps = ar.rejected_steps;
@@ -40,14 +88,7 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   for (const auto& sp : ar.special) {
     if (sp.kind != "fold" || !(sp.point.lambda < T)) continue;
     const SteadyStateResult f = solver.makeDrivenResult(sp.point.x, sp.point.lambda);
-    double ay = 0;
-    if (solver.problem().floating_base.isValid()) {
-      SimTK::State s = f.state;
-      scene.getSystem().realize(s, SimTK::Stage::Velocity);
-      const SimTK::MobilizedBody& b = scene.getMatter().getMobilizedBody(solver.problem().floating_base);
-      const SimTK::Vec3 v = b.getBodyOriginVelocity(s);
-      ay = b.getBodyAngularVelocity(s)[2] * std::hypot(v[0], v[1]);
-    }
+    const double ay = lateralOf(scene, solver, f.state);
     throw Error("no steady state on the branch from straight running: fold at front steer " +
                 (frontSteer ? formatValue(frontSteer(f.state) * 180 / SimTK::Pi) : std::string("(unknown)")) +
                 " deg (lateral acceleration " + formatValue(ay) + " m/s^2), at command time " +
