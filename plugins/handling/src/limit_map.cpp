@@ -22,7 +22,8 @@ const FieldTable<LimitMapSettings>& LimitMapSettings::fields() {
           .number("fold_tolerance_rad", &S::fold_tolerance_rad, "rad",
                   "bracket to which the one-parameter fold is located")
           .number("g_tolerance", &S::g_tolerance, "",
-                  "|bordered test function g| (scaled Jacobian's singular value) at a converged fold-curve point")
+                  "|bordered test function g| at a converged fold-curve point, relative to the scaled Jacobian's "
+                  "second-smallest singular value at the start")
           .integer("max_points", &S::max_points, "", "fold-curve points after the start")
           .number("force_tolerance_N", &S::force_tolerance_N, "N", "max |generalized-force residual|")
           .boolean("stability", &S::stability, "eigenvalues at every point (stable side)")
@@ -121,7 +122,9 @@ LimitMapResult runLimitMap(const HandlingVehicle& v, const LimitMapSettings& set
   sys.x_scale = solver.getUnknownScales();
   sys.r_scale = solver.getEquationScales();
   sys.p_scale = set.front_step_rad;
-  sys.mu_scale = set.speed_step_m_s;
+  // The arclength metric's speed scale: small against the steady state's
+  // scaled change, so that a step's length is mostly speed.
+  sys.mu_scale = 0.05 * set.speed_step_m_s;
   sys.residual = [&](const Eigen::VectorXd& x, double df, double U) {
     setSpeed(U);
     return solver.calcDrivenEquations(x, df);
@@ -145,6 +148,10 @@ LimitMapResult runLimitMap(const HandlingVehicle& v, const LimitMapSettings& set
   fo.continuation.lambda_max = set.speed_max_m_s;
   fo.continuation.max_points = set.max_points;
   fo.continuation.direction = +1;
+  // g's gradient is a second difference (and the tire forces are only
+  // piecewise smooth): the corrector converges linearly, in ~6-9 iterations.
+  fo.continuation.fast_iterations = 6;
+  fo.continuation.max_corrector_iterations = 14;
   fo.continuation.location_tolerance = 1e-3 * set.speed_step_m_s;
   fo.continuation.stability_tolerance = set.stability_tolerance_per_s;
 

@@ -134,8 +134,11 @@ FoldCurveResult continueFoldCurve(const TwoParameterSystem& sys, const Eigen::Ve
     G(n, n + 1) = column(x, p, mu + hm, hm);
     return G;
   };
-  ext.converged = [&](const Eigen::VectorXd& rz) {
-    return sys.converged(rz.head(n)) && std::abs(rz[n]) <= options.g_tolerance;
+  // g's noise floor is the finite-difference Jacobian's (~1e-8 of A's
+  // scale): g is converged relative to the next singular value.
+  const double gTol = options.g_tolerance * bord.second_singular_value;
+  ext.converged = [&, gTol](const Eigen::VectorXd& rz) {
+    return sys.converged(rz.head(n)) && std::abs(rz[n]) <= gTol;
   };
   if (sys.eigenvalues)
     ext.eigenvalues = [&](const Eigen::VectorXd& z, double mu) {
@@ -154,8 +157,8 @@ FoldCurveResult continueFoldCurve(const TwoParameterSystem& sys, const Eigen::Ve
     if (it >= maxIt || !rz.allFinite())
       throw Error("fold curve: the start (p = " + formatValue(p0) + ", mu = " + formatValue(mu0) +
                   ") did not converge on F = 0, g = 0 in " + std::to_string(maxIt) +
-                  " Newton iterations (|g| = " + formatValue(std::abs(rz[n])) + ", g_tolerance " +
-                  formatValue(options.g_tolerance) + "): not a simple fold");
+                  " Newton iterations (|g| = " + formatValue(std::abs(rz[n])) + ", bound g_tolerance x second "
+                  "singular value = " + formatValue(gTol) + "): not a simple fold");
     const Eigen::MatrixXd G = ext.jacobian(z, mu0, rz);
     const Eigen::MatrixXd Gs = ext.r_scale.asDiagonal() * G.leftCols(n + 1) * S.asDiagonal();
     const Eigen::VectorXd dz = S.cwiseProduct(Gs.fullPivLu().solve(-ext.r_scale.cwiseProduct(rz)));

@@ -36,8 +36,8 @@ struct LimitMapSettings {
   double front_step_rad = 0.005;      ///< largest step of the one-parameter continuation in delta_f, rad
   double front_max_rad = 0.5;         ///< no fold below this front angle: Error, rad
   double fold_tolerance_rad = 1e-9;   ///< bracket of the one-parameter fold's location, rad
-  double g_tolerance = 1e-10;         ///< |bordered test function| at convergence of a fold-curve point
-  int max_points = 60;                ///< fold-curve points after the start
+  double g_tolerance = 1e-5;          ///< |bordered test function g| at convergence, relative to the second singular value
+  int max_points = 150;               ///< fold-curve points after the start
   double force_tolerance_N = 1e-6;    ///< steady-state residual, N
   bool stability = true;              ///< eigenvalues at every point
   double stability_tolerance_per_s = 1e-6;  ///< stable when real parts < -tolerance, 1/s

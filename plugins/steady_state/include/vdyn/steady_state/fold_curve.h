@@ -45,11 +45,13 @@ struct TwoParameterSystem {
 
 struct FoldCurveOptions {
   ArclengthOptions continuation;   ///< in mu's unit (step, min/max step, mu range, points)
-  /// |g| at convergence (g: the smallest singular value's scale of A, dimensionless).
-  double g_tolerance = 1e-9;
+  /// |g| at convergence, relative to A's second-smallest singular value at
+  /// the start (g has A's scale; its floor is the finite-difference
+  /// Jacobian's noise, ~1e-8 relative).
+  double g_tolerance = 1e-6;
   /// Steps of the mixed second difference of g's gradient, in the scaled
   /// variables (x / x_scale, p / p_scale, mu / mu_scale).
-  double difference_step = 1e-5;
+  double difference_step = 1e-3;
 };
 
 /// The bordering of a fold: b, c (unit, n) and the test function's value there.
