@@ -75,16 +75,23 @@ void plotMap(const std::string& dir, AnalysisResult& res) {
     const std::string y = panel == 0 ? "front_deg" : "lateral_accel_m_s2";
     s += std::string("set xlabel \"speed U0 (m/s)\"\nset ylabel ") +
          (panel == 0 ? "\"front road-wheel angle at the fold (deg)\"" : "\"lateral acceleration at the fold (m/s^2)\"") +
-         "\nset yrange [0:*]\nplot ";
+         "\nplot ";
     for (std::size_t i = 0; i < res.tables.size(); ++i) {
       const auto& [name, t] = res.tables[i];
       t.writeCsv(dir + "/" + name + ".csv");
       const std::string f = gnuplotQuote(dir + "/" + name + ".csv"), c = gnuplotQuote(colours[i % 4]);
       const std::string label = name.substr(std::string("limit_map_").size());
-      s += std::string(i ? ", \\\n     " : "") + f + " using (column(\"speed_m_s\")):(column(\"stable_" + y +
-           "\")) with filledcurves y1=0 fs transparent solid 0.2 noborder lc rgb " + c + " title " +
-           gnuplotQuote(label + ": stable") + ", \\\n     " + f + " using (column(\"speed_m_s\")):(column(\"" + y +
-           "\")) with linespoints lw 2 pt 7 ps 0.6 lc rgb " + c + " title " + gnuplotQuote(label + ": fold");
+      // The stable region only where a point has a stable side (gnuplot fails on a series without points).
+      const auto col = std::size_t(std::find(t.columns.begin(), t.columns.end(), "stable_" + y) - t.columns.begin());
+      const bool anyStable =
+          std::any_of(t.rows.begin(), t.rows.end(), [col](const std::vector<double>& r) { return std::isfinite(r[col]); });
+      s += std::string(i ? ", \\\n     " : "");
+      if (anyStable)
+        s += f + " using (column(\"speed_m_s\")):(column(\"stable_" + y +
+             "\")) with filledcurves y1=0 fs transparent solid 0.2 noborder lc rgb " + c + " title " +
+             gnuplotQuote(label + ": stable") + ", \\\n     ";
+      s += f + " using (column(\"speed_m_s\")):(column(\"" + y + "\")) with linespoints lw 2 pt 7 ps 0.6 lc rgb " + c +
+           " title " + gnuplotQuote(label + ": fold");
     }
     s += "\n";
   }
