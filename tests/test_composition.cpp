@@ -238,10 +238,28 @@ TEST(Composition, LibraryTireInVehicleReport) {
   expectTireReaches(quarterCarScene(R"({"type": "vehicle_report", "travel_range_m": 0.02, "travel_step_m": 0.01})"_json));
 }
 
+// limit_map: the linear tires have no friction limit, so the steady turn has
+// no fold in the front angle; with either tire the map stops with the named
+// error (the library tire reached the solver: the branch was followed on it).
+TEST(Composition, LibraryTireInLimitMap) {
+  for (const char* tire : {"linear", "fixture_stiff_linear"}) {
+    Json s = bicycleScene(R"({"type": "limit_map", "speed_start_m_s": 10, "speed_max_m_s": 12,
+        "front_step_rad": 0.01, "front_max_rad": 0.03, "stability": false})"_json);
+    s["vehicle"]["overrides"]["tire"] = {{"plugin", tire}, {"params", {{"mu_max", nullptr}, {"mu_min", nullptr}}}};
+    try {
+      runScene(SceneDescription::fromJson(s, "composition.json", registry()));
+      ADD_FAILURE() << tire << ": a fold on linear tires";
+    } catch (const Error& e) {
+      EXPECT_NE(std::string(e.what()).find("no fold of the steady turn in the front angle"), std::string::npos)
+          << e.what();
+    }
+  }
+}
+
 // Every registered analysis type has a test above (a new one must add its own).
 TEST(Composition, EveryRegisteredAnalysisIsCovered) {
   const std::vector<std::string> covered = {"continuation", "iso3888_2", "iso4138_constant_radius", "iso7401",
-                                            "optimal_ratio", "sensitivity", "sine_with_dwell", "stability",
+                                            "limit_map", "optimal_ratio", "sensitivity", "sine_with_dwell", "stability",
                                             "static_equilibrium", "steady_state", "transient", "vehicle_report"};
   std::vector<std::string> known = registry().known(PluginKind::Analysis);
   std::sort(known.begin(), known.end());

@@ -467,7 +467,10 @@ std::vector<FieldInfo> withVehicleKeys(std::vector<FieldInfo> f) {
 }
 }  // namespace
 
+void registerLimitMapAnalysis(PluginRegistry& registry);  // limit_map_analysis.cpp
+
 void registerHandlingAnalyses(PluginRegistry& registry) {
+  registerLimitMapAnalysis(registry);
   registry.addAnalysis(
       "iso4138_constant_radius", [](const ParamReader& r) { return std::make_unique<ConstantRadiusAnalysis>(r); },
       {"ISO 4138 steady-state circular driving, constant radius: steady-state solves (steering angle unknown, U = r R) "
