@@ -4,6 +4,13 @@
 
 namespace vdyn {
 
+std::string oneLineMessage(const std::exception& e) {
+  std::string msg = e.what();
+  for (auto& c : msg)
+    if (c == '\n') c = ' ';
+  return msg;
+}
+
 std::string formatValue(double v) {
   // Plain notation where 15 significant digits round-trip (-200, 0.02, 1e-05);
   // 17 digits otherwise.

@@ -369,9 +369,24 @@ void loadSceneLibraries(const SceneDescription& scene, PluginRegistry& registry)
   for (const auto& lib : scene.pluginLibraries()) loadPluginLibrary(lib, registry);
 }
 
+std::vector<std::string> checkScene(const SceneDescription& scene, PluginRegistry& registry) {
+  std::vector<std::string> errors;
+  try {
+    loadSceneLibraries(scene, registry);
+  } catch (const Error& e) {
+    errors.push_back(e.what());
+  }
+  for (const auto& e : scene.check()) errors.push_back(e);
+  return errors;
+}
+
 std::string defaultOutputDir(const SceneDescription& scene) { return "results/" + scene.name(); }
 
 Json runScene(const SceneDescription& scene, const RunOptions& options) {
+  return runSceneWithTables(scene, options).summary;
+}
+
+SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& options) {
   BuiltScene built = scene.build();
   if (!options.out_dir.empty()) {
     std::error_code ec;
@@ -393,7 +408,9 @@ Json runScene(const SceneDescription& scene, const RunOptions& options) {
     const std::string path = options.out_dir + "/summary.json";
     writeFileAtomic(path, summary.dump(2) + "\n");
   }
-  return summary;
+  SceneRun run{std::move(summary), std::move(r.tables), {{"t_s", "s"}}};
+  for (const auto& n : built.scene().getOutputNames()) run.units[n] = built.scene().getOutput(n).unit;
+  return run;
 }
 
 Json runSceneFile(const std::string& path, const std::vector<Override>& overrides, PluginRegistry& registry,

@@ -2,6 +2,7 @@
 
 #include "vdyn/core/interrupt.h"
 #include "vdyn/core/key_path.h"
+#include "vdyn/core/scene_file.h"
 
 #include <algorithm>
 #include <cassert>
@@ -512,6 +513,30 @@ void collectValues(const SweepDescription& d, SweepRow& row) {
     }
     row.values[k] = *v;
   }
+}
+
+namespace {
+std::vector<Override> toOverrides(const std::vector<SweepSetting>& settings) {
+  std::vector<Override> o;
+  for (const auto& s : settings) o.push_back(Override{s.key, s.value});
+  return o;
+}
+}  // namespace
+
+SweepRunFunction makeSceneSweepRun(const SweepDescription& d, PluginRegistry& registry,
+                                   const std::string& runFilesDir) {
+  const SceneDescription base = SceneDescription::fromFile(d.scene, registry, toOverrides(d.common));
+  loadSceneLibraries(base, registry);
+  if (d.variations.empty()) throw Error((d.file.empty() ? "sweep" : d.file) + ": no variations");
+  const auto errors = base.withOverrides(toOverrides(d.variations.front().settings)).check();
+  if (!errors.empty())
+    throw Error(d.file + ": variation 0 (" + d.variations.front().id() + "): " + errors.front());
+  return [base, runFilesDir](const SweepDescription&, const Variation& v) {
+    RunOptions ro;
+    ro.plots = false;  // per-run CSV and summary only: no gnuplot process per run
+    if (!runFilesDir.empty()) ro.out_dir = runFilesDir + "/" + std::to_string(v.index);
+    return runScene(base.withOverrides(toOverrides(v.settings)), ro);
+  };
 }
 
 SweepRow runVariation(const SweepDescription& d, const Variation& v, const SweepRunFunction& run) {

@@ -33,9 +33,7 @@ int run(const std::string& study, const std::function<void()>& body) {
     std::cerr << study << ": " << e.what() << std::endl;
     return 128 + e.signal();
   } catch (const std::exception& e) {
-    std::string msg = e.what();
-    for (auto& c : msg)
-      if (c == '\n') c = ' ';
+    const std::string msg = oneLineMessage(e);
     // The run failed before its summary: say so in summary.json, so that folder
     // never holds a summary that looks like a result (best effort: the error
     // itself may be that nothing can be written there).

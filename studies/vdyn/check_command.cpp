@@ -32,13 +32,7 @@ int checkCommand(const std::vector<std::string>& args) {
                     p.is_object() ? p.value("type", std::string("?")).c_str() : "?");
     std::printf("\n");
   }
-  std::vector<std::string> errors;
-  try {
-    loadSceneLibraries(scene, registry);
-  } catch (const Error& e) {
-    errors.push_back(e.what());
-  }
-  for (const auto& e : scene.check()) errors.push_back(e);
+  const std::vector<std::string> errors = checkScene(scene, registry);
   for (const auto& e : errors) std::fprintf(stderr, "vdyn check: error: %s\n", e.c_str());
   if (!errors.empty()) return 1;
   std::printf("vdyn check: %s: ok\n", scene.path().c_str());

@@ -32,12 +32,6 @@ namespace vdyn::cli {
 
 namespace {
 
-std::vector<Override> toOverrides(const std::vector<SweepSetting>& settings) {
-  std::vector<Override> o;
-  for (const auto& s : settings) o.push_back(Override{s.key, s.value});
-  return o;
-}
-
 /// The last key of a (checked) key path with any indices after it: "steps[1]" of "a.steps[1]".
 std::string lastSegment(const std::string& path) {
   const KeyPath k = KeyPath::parse(path, "sweep");
@@ -129,25 +123,10 @@ int sweepCommand(const std::vector<std::string>& args) {
   // threads start: plugin libraries change the registry).
   const SweepDescription sweep = SweepDescription::fromFile(resolveDataPath(vm["sweep"].as<std::string>()));
   PluginRegistry& registry = registryWithPlugins(vm);
-  const SceneDescription base = SceneDescription::fromFile(sweep.scene, registry, toOverrides(sweep.common));
-  loadSceneLibraries(base, registry);
-  {
-    // A misspelt key path would fail every run: the first variation is checked
-    // the way build() checks a scene (strict keys), and stops the sweep.
-    const auto errors = base.withOverrides(toOverrides(sweep.variations.at(0).settings)).check();
-    if (!errors.empty())
-      throw Error(sweep.file + ": variation 0 (" + sweep.variations[0].id() + "): " + errors.front());
-  }
   const std::string out = vm.count("out") ? vm["out"].as<std::string>()
                           : !sweep.output.empty() ? sweep.output
                                                   : "results/sweeps/" + sweep.name;
-  const bool runFiles = vm.count("run-files") > 0;
-  const SweepRunFunction run = [&](const SweepDescription&, const Variation& v) {
-    RunOptions ro;
-    ro.plots = false;  // per-run CSV and summary only: no gnuplot process per run
-    if (runFiles) ro.out_dir = out + "/runs/" + std::to_string(v.index);
-    return runScene(base.withOverrides(toOverrides(v.settings)), ro);
-  };
+  const SweepRunFunction run = makeSceneSweepRun(sweep, registry, vm.count("run-files") ? out + "/runs" : "");
 
   SweepOptions so;
   so.out_dir = out;

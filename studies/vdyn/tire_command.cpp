@@ -55,16 +55,6 @@ std::vector<double> range(double lo, double hi, int n) {
   return v;
 }
 
-TireForces evaluate(const TireModel& m, double fz, double alpha, double kappa, double gamma, double vx) {
-  ContactKinematics k;
-  k.deflection_m = calcStaticDeflection(m, fz);
-  k.vx_m_s = vx;
-  k.vy_m_s = vx * std::tan(alpha);
-  k.spin_rad_s = vx * (1 + kappa) / m.calcRollingRadius(k.deflection_m);
-  k.camber_rad = gamma;
-  return m.calcForces(k);
-}
-
 std::string fmt(double v) {
   char b[32];
   std::snprintf(b, sizeof b, "%g", v);
@@ -91,21 +81,8 @@ int tireCommand(const std::vector<std::string>& args) {
   const PluginRegistry& registry = registryWithPlugins(vm);
 
   // The tire as a vehicle would add it: its kind's factory reads the params.
-  TireChoice tire;
-  const bool tir = data.size() > 4 && data.substr(data.size() - 4) == ".tir";
-  if (tir) {
-    tire.plugin = "magic_formula";
-    tire.params = Json{{"file", data}};
-    tire.where = data;
-  } else {
-    const ParamReader r = ParamReader::fromFile(data);
-    tire = TireChoice::fromParams(r.child("tire"));
-    r.markAllRead();  // only the tire block of a vehicle data file is used
-  }
-  const auto plugin = registry.create(PluginKind::ForceElement, tire.plugin, tire.makeSpec("tire", "wheel"), data);
-  const auto* tp = dynamic_cast<const TirePlugin*>(plugin.get());
-  if (!tp) throw Error(data + ": plugin '" + tire.plugin + "' is not a tire");
-  const TireModel& model = tp->getModel();
+  const SteadyTire tire = SteadyTire::fromData(data, registry);
+  const TireModel& model = *tire.model;
 
   const std::vector<double> loads = numberList(vm["fz"].as<std::string>(), "fz", 1.0);
   for (double fz : loads)
@@ -126,7 +103,7 @@ int tireCommand(const std::vector<std::string>& args) {
   const std::vector<std::string> cols = {"Fz_load_N", "alpha_rad", "kappa", "gamma_rad", "Fx_N", "Fy_N",
                                          "Fz_N", "Mx_N_m", "My_N_m", "Mz_N_m"};
   auto row = [&](double fz, double a, double k, double g) {
-    const TireForces f = evaluate(model, fz, a, k, g, vx);
+    const TireForces f = tire.calcForces(fz, a, k, g, vx);
     return std::vector<double>{fz, a, k, g, f.fx_N, f.fy_N, f.fz_N, f.mx_N_m, f.my_N_m, f.mz_N_m};
   };
   // The whole grid, long format (grid.csv; not plotted).
@@ -140,7 +117,7 @@ int tireCommand(const std::vector<std::string>& args) {
   // Curves for the plots: pure lateral and longitudinal slip per load (first
   // camber), and combined slip at the middle load for a few slip angles.
   std::vector<PlotSpec> plots;
-  const std::string what = tire.plugin + " (" + name + ")";
+  const std::string what = tire.kind + " (" + name + ")";
   PlotSpec fy{"Fy_alpha", "Lateral force, pure slip: " + what, "slip angle alpha (rad)", "Fy (N)", {}};
   PlotSpec mz{"Mz_alpha", "Aligning moment, pure slip: " + what, "slip angle alpha (rad)", "Mz (N m)", {}};
   PlotSpec fx{"Fx_kappa", "Longitudinal force, pure slip: " + what, "slip ratio kappa (1)", "Fx (N)", {}};
@@ -169,7 +146,7 @@ int tireCommand(const std::vector<std::string>& args) {
   }
   plots = {fy, mz, fx, ellipse};
   for (const auto& [n, t] : tables) t.writeCsv(out + "/" + n + ".csv");
-  Json summary = {{"tire", tire.plugin}, {"data", data}, {"vx_m_s", vx}, {"loads_N", loads},
+  Json summary = {{"tire", tire.kind}, {"data", data}, {"vx_m_s", vx}, {"loads_N", loads},
                   {"grid_points", grid.rows.size()}, {"unloaded_radius_m", model.vertical().unloaded_radius_m},
                   {"radial_stiffness_N_per_m", model.vertical().radial_stiffness_N_per_m}};
   if (!vm.count("no-plots")) summary["plots"] = renderPlots(out, tables, plots);

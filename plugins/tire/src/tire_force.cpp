@@ -286,4 +286,35 @@ void registerTirePlugins(PluginRegistry& registry) {
       [](const LinearTireParams& p, WheelSide) { return std::make_shared<LinearTire>(p); });
 }
 
+SteadyTire SteadyTire::fromData(const std::string& data, const PluginRegistry& registry) {
+  TireChoice tire;
+  const bool tir = data.size() > 4 && data.substr(data.size() - 4) == ".tir";
+  if (tir) {
+    tire.plugin = "magic_formula";
+    tire.params = Json{{"file", data}};
+    tire.where = data;
+  } else {
+    const ParamReader r = ParamReader::fromFile(data);
+    tire = TireChoice::fromParams(r.child("tire"));
+    r.markAllRead();  // only the tire block of a vehicle data file is used
+  }
+  SteadyTire t;
+  t.kind = tire.plugin;
+  t.plugin = registry.create(PluginKind::ForceElement, tire.plugin, tire.makeSpec("tire", "wheel"), data);
+  const auto* tp = dynamic_cast<const TirePlugin*>(t.plugin.get());
+  if (!tp) throw Error(data + ": plugin '" + tire.plugin + "' is not a tire");
+  t.model = &tp->getModel();
+  return t;
+}
+
+TireForces SteadyTire::calcForces(double fz_N, double alpha_rad, double kappa, double gamma_rad, double vx_m_s) const {
+  ContactKinematics k;
+  k.deflection_m = calcStaticDeflection(*model, fz_N);
+  k.vx_m_s = vx_m_s;
+  k.vy_m_s = vx_m_s * std::tan(alpha_rad);
+  k.spin_rad_s = vx_m_s * (1 + kappa) / model->calcRollingRadius(k.deflection_m);
+  k.camber_rad = gamma_rad;
+  return model->calcForces(k);
+}
+
 }  // namespace vdyn

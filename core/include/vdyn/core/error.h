@@ -16,6 +16,10 @@ class Error : public std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
+/// An error's message on one line (line breaks become spaces): what the
+/// programs print after "error: " and what the Python module's vdyn.Error carries.
+std::string oneLineMessage(const std::exception& e);
+
 /// Formats a double the way error messages quote values (shortest round trip).
 std::string formatValue(double v);
 

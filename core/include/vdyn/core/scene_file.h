@@ -29,6 +29,7 @@
 // separate scenes (or the same description) at once. Only loading plugin
 // libraries changes the registry: do it before starting threads
 // (loadSceneLibraries is serialized and loads each library once).
+#include <map>
 #include <memory>
 #include <string>
 #include <utility>
@@ -125,6 +126,11 @@ class SceneDescription {
 /// Loads the description's plugin libraries into `registry` (plugin_library.h).
 void loadSceneLibraries(const SceneDescription& scene, PluginRegistry& registry);
 
+/// What `vdyn check` reports: the description's plugin libraries loaded into
+/// `registry` (an error loading one is the first line), then every error of
+/// SceneDescription::check(); empty when the scene is valid.
+std::vector<std::string> checkScene(const SceneDescription& scene, PluginRegistry& registry);
+
 struct RunOptions {
   /// Where summary.json, the tables and the analysis's files go; created if
   /// needed. "" writes no files (the summary is still returned).
@@ -135,8 +141,23 @@ struct RunOptions {
   bool plots = true;
 };
 
-/// Builds the scene, runs its analysis, writes the output files and returns
-/// the summary JSON ({"scene", "analysis", ...the analysis's summary}).
+/// What a run of a scene gives: the summary (as in summary.json), the
+/// analysis's tables (written as <name>.csv when there is an output folder)
+/// and the unit of every output of the built scene ("" = dimensionless; the
+/// tables' time column "t_s" is "s").
+struct SceneRun {
+  Json summary;
+  std::vector<std::pair<std::string, Table>> tables;
+  std::map<std::string, std::string> units;
+};
+
+/// Builds the scene, runs its analysis, writes the output files (none when
+/// options.out_dir is "") and returns the summary and tables. `vdyn run`,
+/// `vdyn sweep` and the Python module run scenes through this one function.
+SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& options = {});
+
+/// runSceneWithTables(...).summary: the summary JSON ({"scene", "analysis",
+/// ...the analysis's summary}).
 Json runScene(const SceneDescription& scene, const RunOptions& options = {});
 
 /// Loads a scene file, applies `overrides`, loads its plugin libraries into

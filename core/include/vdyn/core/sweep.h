@@ -166,6 +166,18 @@ struct SweepRow {
 /// Called concurrently from several threads for different variations.
 using SweepRunFunction = std::function<Json(const SweepDescription&, const Variation&)>;
 
+class PluginRegistry;
+/// The run function of a sweep of scene files, as `vdyn sweep` and the Python
+/// module's vdyn.sweep run it: the scene file d.scene with the sweep's "set"
+/// (d.common) applied, its plugin libraries loaded into `registry` (here,
+/// before any thread starts), and variation 0 checked the way build() checks a
+/// scene (a misspelt key path would fail every run: Error naming the sweep
+/// file, the variation and the first error). Each run is runScene() of that
+/// scene with the variation's settings as overrides, without plots; with
+/// `runFilesDir`, its files go to <runFilesDir>/<variation index>/.
+SweepRunFunction makeSceneSweepRun(const SweepDescription& d, PluginRegistry& registry,
+                                   const std::string& runFilesDir = "");
+
 /// Runs one variation: calls `run`, times it, collects the values. Never throws
 /// for a failing run: the row carries the reason.
 SweepRow runVariation(const SweepDescription& d, const Variation& v, const SweepRunFunction& run);

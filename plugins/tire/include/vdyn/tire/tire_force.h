@@ -154,6 +154,27 @@ struct TireChoice {
 /// The static radial deflection of `model` under normal load fz_N (Fz = Kz delta), m.
 double calcStaticDeflection(const TireModel& model, double fz_N);
 
+/// A tire on its own in steady state (`vdyn tire`, the Python module's
+/// vdyn.tire): the tire of a tire data file as a vehicle would add it.
+struct SteadyTire {
+  std::string kind;                 ///< the tire plugin kind (gim, fiala, linear, magic_formula, ...)
+  std::unique_ptr<Plugin> plugin;   ///< owns the law
+  const TireModel* model = nullptr; ///< the plugin's law
+
+  /// `data`: a .tir property file (kind magic_formula) or a JSON file with a
+  /// "tire" block {"plugin": KIND, "params": {...}} (a vehicle data file);
+  /// the kind's factory in `registry` reads the params. Error names the file.
+  static SteadyTire fromData(const std::string& data, const PluginRegistry& registry);
+
+  /// Forces and moments at normal load fz_N (> 0), slip angle alpha_rad, slip
+  /// ratio kappa, camber gamma_rad and forward speed vx_m_s (> 0): the
+  /// deflection carries the load on the radial spring (calcStaticDeflection),
+  /// Vy = vx tan(alpha), the wheel spins at vx (1 + kappa) / Re;
+  /// kappa = (Omega Re - Vx) / |Vx| > 0 driving, alpha > 0 with the patch
+  /// sliding to +y_C, so Fy < 0 there (tire_model.h). No relaxation states.
+  TireForces calcForces(double fz_N, double alpha_rad, double kappa, double gamma_rad, double vx_m_s) const;
+};
+
 namespace detail {
 /// The keys of a tire plugin entry: where the tire sits, and its kind's params P.
 template <class P>
