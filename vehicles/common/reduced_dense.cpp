@@ -71,13 +71,24 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
   for (const Steer& st : steers_) {
     // delta of the knuckle's mobilizer is the angle of (A.1): delta = command.
     RowEval& r = rows_[i++];
-    const SteerCommandValue c = st.command->calcAt(t);
     const int ud = st.knuckle.getFirstUIndex(s) + 1;
-    r.n = 1;
-    r.u[0] = ud, r.g[0] = 1;
-    r.perr = st.knuckle.getOneQ(s, 1) - c.angle_rad;
-    r.verr = u[ud] - c.rate_rad_s;
-    r.b = c.accel_rad_s2 - 2 * w * r.verr - w * w * r.perr;
+    if (st.command) {
+      const SteerCommandValue c = st.command->calcAt(t);
+      r.n = 1;
+      r.u[0] = ud, r.g[0] = 1;
+      r.perr = st.knuckle.getOneQ(s, 1) - c.angle_rad;
+      r.verr = u[ud] - c.rate_rad_s;
+      r.b = c.accel_rad_s2 - 2 * w * r.verr - w * w * r.perr;
+    } else {
+      // State-driven: delta = q_D, q_D'' prescribed (enters through udot0).
+      const int uD = st.steer.getFirstUIndex(s);
+      r.n = 2;
+      r.u[0] = ud, r.g[0] = 1;
+      r.u[1] = uD, r.g[1] = -1;
+      r.perr = st.knuckle.getOneQ(s, 1) - st.steer.getOneQ(s, 0);
+      r.verr = u[ud] - u[uD];
+      r.b = -2 * w * r.verr - w * w * r.perr;
+    }
   }
   for (const Speed& sp : speeds_) {
     // SpeedHoldImpl's row on the Free mobilizer's u = [w_G, v_G] (chassis
