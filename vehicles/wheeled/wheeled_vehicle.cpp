@@ -175,6 +175,8 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params) : WheeledVehi
 
 namespace {
 
+void useSimbodyRowsOf(const Scene& scene, const ReducedDenseRows* dense, SimTK::State& s);
+
 /// Sets every axle's template to the form `p.formulation` asks (auto: the
 /// reduced form if every axle has one, else the constrained); returns the
 /// form and why. Throws Error naming the axle when "reduced" or "dense" is
@@ -277,6 +279,11 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
   if (dense) {
     dense_ = new ReducedDenseRows(sc.getMatter(), sc.getForces());
     SimTK::Force::Custom(sc.updForces(), dense_);  // inactive until useDenseRows()
+    auto service = std::make_shared<ConstraintRowsService>();
+    const Scene* scene = scene_.get();
+    const ReducedDenseRows* rows = dense_;
+    service->use_simbody_rows = [scene, rows](SimTK::State& s) { useSimbodyRowsOf(*scene, rows, s); };
+    sc.setService<const ConstraintRowsService>(kConstraintRowsService, service);
   } else if (templates_.name == "reduced" && p_.formulation == "dense") {
     throw Error("vehicle formulation \"dense\": a reduced template has no dense rows");
   }
@@ -599,7 +606,9 @@ void WheeledVehicle::useDenseRows(SimTK::State& s) const {
   for (const SpeedHoldPlugin* sp : holds) {
     const ReducedDenseRows* dense = dense_;
     const int k = int(speeds.size());
-    sp->setDisabledForceSource([dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); });
+    sp->setExternalRow({[dense](const SimTK::State& st) { return dense->isActive(st); },
+                        [dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); },
+                        [dense, k](SimTK::State& st, bool on) { dense->setSpeedHoldEnabled(st, k, on); }});
     speeds.push_back({chassis_, sp});
   }
   dense_->setRows(std::move(arms), std::move(steers), std::move(speeds));
@@ -613,5 +622,26 @@ void WheeledVehicle::useDenseRows(SimTK::State& s) const {
   for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(s);
   dense_->setActive(s, true);
 }
+
+namespace {
+/// WheeledVehicle::useSimbodyRows on the scene and its dense element (the
+/// scene service holds these, not the vehicle: both live on the heap).
+void useSimbodyRowsOf(const Scene& scene, const ReducedDenseRows* dense, SimTK::State& s) {
+  if (!dense || !dense->isActive(s)) return;
+  std::vector<bool> released;
+  int k = 0;
+  for (const auto& plugin : scene.getPlugins())
+    if (dynamic_cast<const SpeedHoldPlugin*>(plugin.get())) released.push_back(!dense->isSpeedHoldEnabled(s, k++));
+  dense->setActive(s, false);
+  const SimTK::SimbodyMatterSubsystem& m = scene.getMatter();
+  for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).enable(s);
+  k = 0;
+  for (const auto& plugin : scene.getPlugins())
+    if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get()))
+      if (released[k++]) sp->setEnabled(s, false);
+}
+}  // namespace
+
+void WheeledVehicle::useSimbodyRows(SimTK::State& s) const { useSimbodyRowsOf(*scene_, dense_, s); }
 
 }  // namespace vdyn

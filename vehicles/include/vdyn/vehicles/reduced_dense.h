@@ -91,8 +91,13 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   /// every row (rad/s; m/s for the speed hold) in `s` (Stage::Velocity).
   std::pair<double, double> calcRowErrors(const SimTK::State& s) const;
   /// Force of the k-th speed hold along the direction of travel, N
-  /// (SpeedHoldPlugin::calcForce's sign), in a dense state (Stage::Dynamics).
+  /// (SpeedHoldPlugin::calcForce's sign), in a dense state (Stage::Dynamics);
+  /// 0 when it is released.
   double speedHoldForce(const SimTK::State& s, int k) const;
+  /// Releases (false) or engages (true) the k-th speed hold's row in a dense
+  /// state (SpeedHoldPlugin::setEnabled; invalidates Stage::Instance).
+  void setSpeedHoldEnabled(SimTK::State& s, int k, bool enabled) const;
+  bool isSpeedHoldEnabled(const SimTK::State& s, int k) const;
 
   // Force::Custom::Implementation
   void calcForce(const SimTK::State&, SimTK::Vector_<SimTK::SpatialVec>&, SimTK::Vector_<SimTK::Vec3>&,
@@ -121,6 +126,7 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   std::vector<Steer> steers_;
   std::vector<Speed> speeds_;
   mutable SimTK::DiscreteVariableIndex activeIndex_;
+  mutable SimTK::DiscreteVariableIndex releasedIndex_;  ///< std::vector<int>: 1 = the k-th hold released
   mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
   // Workspace.
   mutable std::vector<RowEval> rows_;

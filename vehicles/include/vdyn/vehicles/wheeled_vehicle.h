@@ -234,6 +234,9 @@ class WheeledVehicle {
   /// has no dense formulation or for a row it cannot solve (a rack, any other
   /// constraint). Call after every plugin has been added.
   void useDenseRows(SimTK::State& s) const;
+  /// The reverse of useDenseRows: `s` with Simbody's rows (a released speed
+  /// hold stays released); nothing in a state that is not dense.
+  void useSimbodyRows(SimTK::State& s) const;
   /// The dense rows' force element (null unless every axle supports them).
   const ReducedDenseRows* denseRows() const { return dense_; }
   const TirePlugin& tire(int c) const { return *tires_.at(c); }
