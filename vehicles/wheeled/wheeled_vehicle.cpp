@@ -562,6 +562,12 @@ bool WheeledVehicle::collectDenseRows(std::vector<ReducedDenseRows::Arm>* arms,
   for (const auto& plugin : sc.getPlugins()) {
     if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get())) {
       if (st->drivesRack()) return fail("steering plugin '" + plugin->name() + "' drives a rack");
+      // Simbody projects its rows onto the new velocity level when a
+      // command's rate jumps (the integrator restarts there); the dense rows
+      // are only held by their Baumgarte terms and would lag the jump.
+      if (st->sharedCommand() && !st->sharedCommand()->getRateJumpTimes().empty())
+        return fail("steering plugin '" + plugin->name() + "''s command has rate jumps (the dense rows are not "
+                    "projected at a jump)");
       if (sc.getBody(st->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
         return fail("steering plugin '" + plugin->name() + "' is not on the chassis");
       for (const std::string& k : st->knuckleBodies()) {
