@@ -23,7 +23,7 @@ namespace {
 
 WheeledVehicleParams arbParams(bool bar = true, bool reduced = true) {
   WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a_arb.json");
-  if (reduced) p.setSuspensionTemplate("double_wishbone_reduced");
+  p.formulation = reduced ? "reduced" : "constrained";
   if (!bar) p.updAxle("front").anti_roll_bar = Json::object();
   return p;
 }

@@ -11,7 +11,14 @@
 using namespace vdyn;
 
 namespace {
-WheeledVehicleParams appendixA() { return WheeledVehicleParams::fromFile("appendix_a.json"); }
+/// App. A's constrained (reference) model: these tests count its bodies, rows
+/// and degrees of freedom and read its constrained corners (corner()), which
+/// the default formulation (auto: the reduced templates) does not build.
+WheeledVehicleParams appendixA() {
+  WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a.json");
+  p.formulation = "constrained";
+  return p;
+}
 }  // namespace
 
 TEST(FourWs, ModelSizeWithoutSteering) {

@@ -24,7 +24,7 @@ const double kDeg = SimTK::Pi / 180;
 
 WheeledVehicleParams params(const std::string& model, const std::string& file = "appendix_a.json") {
   WheeledVehicleParams p = WheeledVehicleParams::fromFile(file);
-  p.setSuspensionTemplate(model == "reduced" ? "double_wishbone_reduced" : "double_wishbone");
+  p.formulation = model;  // "constrained" or "reduced" (rows Simbody's; "dense" switches them, useDenseRows)
   return p;
 }
 
@@ -44,7 +44,7 @@ std::unique_ptr<WheeledVehicle> ch3Car(const std::string& model, const std::stri
 
 /// The two corner models compared throughout.
 const char* const kModels[2] = {"constrained", "reduced"};
-const char* const kTemplates[2] = {"double_wishbone", "double_wishbone_reduced"};
+
 
 double vee(const SimTK::Mat33& W, int i) {
   return i == 0 ? 0.5 * (W(2, 1) - W(1, 2)) : i == 1 ? 0.5 * (W(0, 2) - W(2, 0)) : 0.5 * (W(1, 0) - W(0, 1));
@@ -262,8 +262,7 @@ TEST(ReducedCorner, MixedSensitivityAgreesWithTheConstrainedModel) {
     SensitivityProblem p;
     p.model = SceneDesign::fromAnalysis(SceneDescription::fromFile(
         "scenes/ch4_sensitivity_fourws.json", standardRegistry(),
-        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.axles.front.suspension.template", kTemplates[m]},
-         {"vehicle.overrides.axles.rear.suspension.template", kTemplates[m]}}));
+        {{"vehicle.data", "appendix_a_relaxation.json"}, {"vehicle.overrides.formulation", kModels[m]}}));
     p.parameters = {"front.spring.stiffness_N_per_m"};
     p.cost = CostFunctional::parse("integral_of_square:chassis.roll_rate_rad_s");
     p.t_end_s = 1.0;
@@ -314,27 +313,36 @@ TEST(ReducedDense, SameCh3TransientAsSimbodysRows) {
   EXPECT_LT(verr, 1e-8);
 }
 
-TEST(ReducedDense, NeedsTheReducedModelAndTimeCommands) {
-  WheeledVehicleParams p = params("constrained");
-  p.forward_dynamics = "dense";
+TEST(ReducedDense, NeedsReducedTemplatesAndRowsItSolves) {
+  // "dense" (or "reduced") asked of an axle without a reduced form: named Error.
+  WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a_solid_rear.json");
+  p.formulation = "dense";
   EXPECT_EQ(vdyn::test::errorOf([&] { WheeledVehicle car(p); }),
-            "vehicle forward_dynamics \"dense\" needs every axle's suspension template to have a dense formulation "
-            "(double_wishbone_reduced); axle 'front' is double_wishbone");
+            "vehicle formulation \"dense\": axle 'rear''s template solid_axle has no reduced form (formulation "
+            "\"constrained\" or \"auto\" runs it)");
+  // auto: constrained, and says why.
+  p.formulation = "auto";
+  const WheeledVehicle solid(p);
+  EXPECT_EQ(solid.getFormulation().name, "constrained");
+  EXPECT_EQ(solid.getFormulation().why, "axle 'rear''s template solid_axle has no reduced form");
+  // The constrained model has no dense rows.
   const auto con = ch3Car("constrained", "appendix_a.json", true);
+  EXPECT_EQ(con->getFormulation().name, "constrained");
+  EXPECT_EQ(con->getFormulation().why, "asked (formulation \"constrained\")");
   SimTK::State s = con->makeInitialState(10.0);
   EXPECT_THROW(con->useDenseRows(s), Error);
-  // A state-driven steering plugin is not a time command: named Error.
-  auto red = std::make_unique<WheeledVehicle>(params("reduced"));
-  struct Zero : SteeringLaw {
-    Zero() : SteeringLaw("zero") {}
-    double DoCalcAcceleration(const SimTK::State&) const override { return 0; }
-  };
-  red->addAxleSteering("front_steer", "front", SteeringStateSpec{}).setAccelerationLaw(std::make_shared<Zero>());
-  SimTK::State sr = red->getScene().getDefaultState();
-  try {
-    red->useDenseRows(sr);
-    ADD_FAILURE() << "no error";
-  } catch (const Error& e) {
-    EXPECT_NE(std::string(e.what()).find("front_steer"), std::string::npos) << e.what();
-  }
+  // auto on App. A: the reduced templates, dense rows.
+  const auto au = ch3Car("auto", "appendix_a.json", true);
+  EXPECT_TRUE(au->isReduced());
+  EXPECT_EQ(au->getFormulation().name, "dense");
+  EXPECT_EQ(au->getFormulation().why, "every axle's template supports it");
+  EXPECT_TRUE(au->denseRows()->isActive(au->makeInitialState(10.0)));
+  // A constraint the dense rows do not solve (a body lock): auto stays on
+  // Simbody's rows, reduced, and names it; "dense" is an Error naming it.
+  auto locked = ch3Car("auto", "appendix_a.json", true);
+  SimTK::MobilizedBody chassis = locked->chassis();  // a handle
+  SimTK::Constraint::Weld(locked->updScene().updMatter().Ground(), chassis);
+  EXPECT_EQ(locked->getFormulation().name, "reduced");
+  EXPECT_NE(locked->getFormulation().why.find("constraint the dense system does not solve"), std::string::npos)
+      << locked->getFormulation().why;
 }

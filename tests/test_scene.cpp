@@ -507,14 +507,13 @@ TEST(SceneAnalyses, ContinuationAgreesWithSteadyState) {
   EXPECT_EQ(co["points"][1]["value"].get<double>(), 12.0);
 }
 
-// A reduced 4WS vehicle built from a scene file (double_wishbone_reduced as
-// vehicle overrides, steering plugins from the registry) starts from the same
+// A reduced 4WS vehicle built from a scene file (formulation "reduced" as a
+// vehicle override, steering plugins from the registry) starts from the same
 // state as the same composition in C++ (WheeledVehicle::addAxleSteering): the
 // constrained copy it is assembled from carries the scene's steering holds
 // (front 0.05 rad, rear 0.02 rad), so positions and speeds agree bit for bit.
 TEST(SceneFile, ReducedFourWsStartsLikeTheCxxCompositionWithItsSteeringHolds) {
-  Json extra = R"({"vehicle": {"overrides": {"axles": {"front": {"suspension": {"template": "double_wishbone_reduced"}},
-                                                      "rear": {"suspension": {"template": "double_wishbone_reduced"}}}}}})"_json;
+  Json extra = R"({"vehicle": {"overrides": {"formulation": "reduced"}}})"_json;
   Json j = smallScene(extra).json();
   j["plugins"].insert(j["plugins"].begin() + 1, R"({"type": "steering", "name": "rear_steer", "attach": "rear_axle",
                                                     "command": {"type": "hold", "angle_rad": 0.02}})"_json);
@@ -523,7 +522,7 @@ TEST(SceneFile, ReducedFourWsStartsLikeTheCxxCompositionWithItsSteeringHolds) {
   const SimTK::State ss = built.makeInitialState();
 
   WheeledVehicleParams p = WheeledVehicleParams::fromFile("appendix_a.json");
-  p.setSuspensionTemplate("double_wishbone_reduced");
+  p.formulation = "reduced";
   WheeledVehicle car(p);
   car.addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(0.05));
   car.addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(0.02));

@@ -25,7 +25,7 @@ kr::Vec3 arr(const SimTK::Vec3& v) { return {v[0], v[1], v[2]}; }
 
 TEST(WishboneReference, AppendixACornersMatchTheReference) {
   vdyn::WheeledVehicleParams p = vdyn::WheeledVehicleParams::fromFile("appendix_a.json");
-  p.setSuspensionTemplate("double_wishbone_reduced");
+  p.formulation = "reduced";
   const vdyn::WheeledVehicle car(p);
   const SimTK::MultibodySystem& sys = car.getScene().getSystem();
   SimTK::State s = car.makeInitialState();

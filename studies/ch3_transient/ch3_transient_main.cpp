@@ -64,9 +64,9 @@ int main(int argc, char** argv) {
     const int dof = tr.vehicle.at("dof").get<int>();
     const double totalMass = tr.vehicle.at("total_mass_kg").get<double>();
     const double assemblyMove = tr.vehicle.at("assembly_max_body_move_m").get<double>();
-    // "reduced" when the App. A axles are double_wishbone_reduced, else "constrained".
-    const std::string cornerModel =
-        tr.vehicle.at("suspensions").value("front", "") == "double_wishbone_reduced" ? "reduced" : "constrained";
+    // The formulation that ran (constrained, reduced, dense) and why (WheeledVehicle::getFormulation).
+    const std::string formulation = tr.vehicle.at("formulation").get<std::string>();
+    const std::string formulationWhy = tr.vehicle.at("formulation_why").get<std::string>();
     const std::string csv = out + "/history.csv";
     rec.writeCsv(csv);
     const double steadyWindow = 2.0, steadyRel = 1e-3, steadyAbs = 1e-5;
@@ -115,7 +115,8 @@ int main(int argc, char** argv) {
                     {"real_time_factor", run.sim_time_s / run.wall_time_s},
                     {"steps", run.steps},
                     {"evaluations", run.realizations},
-                    {"corner_model", cornerModel},
+                    {"formulation", formulation},
+                    {"formulation_why", formulationWhy},
                     {"integrator", run.integrator},
                     {"accuracy", run.accuracy},
                     {"assembly_max_body_move_m", assemblyMove}};
@@ -147,9 +148,9 @@ int main(int argc, char** argv) {
     std::printf("  wheel spins         RF %.4f LF %.4f RR %.4f LR %.4f rad/s\n", fin("rf.spin_rad_s"),
                 fin("lf.spin_rad_s"), fin("rr.spin_rad_s"), fin("lr.spin_rad_s"));
     std::printf("  dof %d, mass %.1f kg, max constraint error %.2e, max |steer - command| %.2e rad, %d steps, "
-                "%d evaluations (%s corners)\n",
-                dof, totalMass, run.max_constraint_error, steerError, run.steps, run.realizations,
-                cornerModel.c_str());
+                "%d evaluations\n",
+                dof, totalMass, run.max_constraint_error, steerError, run.steps, run.realizations);
+    std::printf("  formulation         %s: %s\n", formulation.c_str(), formulationWhy.c_str());
     std::printf("  wall time %.3f s for %.1f s simulated: real-time factor %.1f\n", run.wall_time_s, run.sim_time_s,
                 run.sim_time_s / run.wall_time_s);
     if (!verdict.steady)

@@ -25,9 +25,9 @@ struct Ch3Case {
   double steer_start_s = 0.5, steer_duration_s = 1.0;  ///< t_i and T of (7.4), s
   TransientSettings transient{};     ///< the scene's "analysis" (a transient)
   SimulationSettings sim{};          ///< transient.simulation()
-  /// "constrained" or "reduced" sets both App. A axles' suspension template
-  /// (double_wishbone, double_wishbone_reduced); empty keeps the vehicle file's.
-  std::string corner_model{};
+  /// --formulation: the vehicle's "formulation" (auto, constrained, reduced,
+  /// dense; WheeledVehicleParams::formulation); empty keeps the vehicle file's.
+  std::string formulation{};
 
   /// Adds --speed-m-s, --front-deg, --rear-deg, --t-end-s (help text given),
   /// --integrator, --accuracy.
@@ -36,9 +36,10 @@ struct Ch3Case {
         "front-deg", po::value<double>(), "final front steering angle, deg, + left (seed: 4)")(
         "rear-deg", po::value<double>(), "final rear steering angle, deg, + left (seed: 1)")(
         "t-end-s", po::value<double>(), tEndHelp.c_str())(
-        "corner-model", po::value<std::string>(),
-        "constrained (loops closed by constraints, the reference) or reduced (loops solved in the tree); "
-        "default: the vehicle file's suspension templates");
+        "formulation", po::value<std::string>(),
+        "auto, constrained (loops closed by constraints, the reference), reduced (loops solved in the tree) or "
+        "dense (reduced, the rows solved as one dense system): sets vehicle.overrides.formulation; default: the "
+        "vehicle file's (auto)");
     addIntegratorOptions(opts);
   }
 
@@ -73,10 +74,10 @@ struct Ch3Case {
     if (has("t-end-s")) o.push_back({"analysis.t_end_s", optionOr(v, "t-end-s", 0.0, "").value});
     if (has("integrator")) o.push_back({"analysis.integrator.method", v["integrator"].as<std::string>()});
     if (has("accuracy")) o.push_back({"analysis.integrator.accuracy", optionOr(v, "accuracy", 0.0, "").value});
-    std::string cornerModel;
-    if (has("corner-model")) {
-      cornerModel = checkedCornerModel(v["corner-model"].as<std::string>());
-      for (const char* key : kTemplateKeys) o.push_back({key, suspensionTemplate(cornerModel)});
+    std::string formulation;
+    if (has("formulation")) {
+      formulation = checkedFormulation(v["formulation"].as<std::string>());
+      o.push_back({kFormulationKey, formulation});
     }
     Ch3Case c{SceneDescription::fromFile(sceneFile, standardRegistry(), o)};
     const Json& j = c.scene.json();
@@ -106,7 +107,7 @@ struct Ch3Case {
     c.transient = TransientSettings::fields().read(
         ParamReader::fromJson(j.at("analysis"), where + " analysis"));
     c.sim = c.transient.simulation();
-    c.corner_model = cornerModel;
+    c.formulation = formulation;
     checkRunTimes(Given{c.sim.t_end_s, has("t-end-s") ? "--t-end-s" : where + ": analysis.t_end_s"},
                   Given{c.sim.report_interval_s, where + ": analysis.report_interval_s"});
     // semi_explicit_euler2's error estimate does not bound the error of this
@@ -125,27 +126,21 @@ struct Ch3Case {
   double settledTime() const { return steer_start_s + steer_duration_s; }
 
   /// The scene: the vehicle with its steering ("front_steer", "rear_steer")
-  /// and speed hold ("speed_hold"), built by the scene loader. `cornerModel`
-  /// (if not empty) sets both axles' suspension template. Code that needs the
+  /// and speed hold ("speed_hold"), built by the scene loader. `formulation`
+  /// (if not empty) sets the vehicle's "formulation". Code that needs the
   /// vehicle's own C++ API takes it from the built scene:
   /// build().vehicleAs<WheeledVehicle>().
-  BuiltScene build(const std::string& cornerModel = "") const {
-    if (cornerModel.empty()) return scene.build();
-    const std::string t = suspensionTemplate(checkedCornerModel(cornerModel));
-    return scene.withOverride(kTemplateKeys[0], t).withOverride(kTemplateKeys[1], t).build();
+  BuiltScene build(const std::string& formulation = "") const {
+    if (formulation.empty()) return scene.build();
+    return scene.withOverride(kFormulationKey, checkedFormulation(formulation)).build();
   }
 
-  /// The scene keys of the two App. A axles' suspension templates.
-  static constexpr const char* kTemplateKeys[2] = {"vehicle.overrides.axles.front.suspension.template",
-                                                   "vehicle.overrides.axles.rear.suspension.template"};
-  /// The template of a corner model: double_wishbone or double_wishbone_reduced.
-  static std::string suspensionTemplate(const std::string& cornerModel) {
-    return cornerModel == "reduced" ? "double_wishbone_reduced" : "double_wishbone";
-  }
+  /// The scene key of the vehicle's formulation.
+  static constexpr const char* kFormulationKey = "vehicle.overrides.formulation";
 
-  static std::string checkedCornerModel(const std::string& m) {
-    if (m != "constrained" && m != "reduced")
-      throw Error("--corner-model must be constrained or reduced, got '" + m + "'");
+  static std::string checkedFormulation(const std::string& m) {
+    if (m != "auto" && m != "constrained" && m != "reduced" && m != "dense")
+      throw Error("--formulation must be auto, constrained, reduced or dense, got '" + m + "'");
     return m;
   }
 };

@@ -249,7 +249,7 @@ opt_cases = [
     ('IntegratorUnknown', '--integrator euler', "unknown integrator 'euler'"),
     ('IntegratorEmpty', '--integrator ""', "unknown integrator ''"),
     ('SemiExplicitEuler', '--integrator semi_explicit_euler2 --accuracy 1e-3', 'is refused for the chapter 3 vehicle'),
-    ('CornerModel', '--corner-model rigid', "--corner-model must be constrained or reduced, got 'rigid'"),
+    ('Formulation', '--formulation rigid', "--formulation must be auto, constrained, reduced or dense, got 'rigid'"),
     ('Positional', 'stray', "unexpected argument 'stray'"),
     ('PositionalNumber', '10', "unexpected argument '10'"),
     ('UnknownOption', '--speed 3', 'bad command line'),

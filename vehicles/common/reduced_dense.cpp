@@ -17,14 +17,31 @@ void ReducedDenseRows::setRows(std::vector<Arm> arms, std::vector<Steer> steers,
 
 void ReducedDenseRows::realizeTopology(SimTK::State& s) const {
   activeIndex_ = forces_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<bool>(false));
+  releasedIndex_ =
+      forces_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<std::vector<int>>());
   lambdaIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Dynamics, new SimTK::Value<SimTK::Vector>());
 }
 
 double ReducedDenseRows::speedHoldForce(const SimTK::State& s, int k) const {
   if (!isActive(s)) throw Error("reduced dense dynamics: speedHoldForce in a state that is not dense");
+  if (!isSpeedHoldEnabled(s, k)) return 0;
   const SimTK::Vector& lambda = SimTK::Value<SimTK::Vector>::downcast(forces_->getCacheEntry(s, lambdaIndex_)).get();
-  // This element applies +G^T lambda (Simbody applies -G^T lambda for its rows).
-  return lambda[int(arms_.size() * 2 + steers_.size()) + k];
+  // This element applies +G^T lambda (Simbody applies -G^T lambda for its rows);
+  // the rows of released holds are left out.
+  int row = int(arms_.size() * 2 + steers_.size());
+  for (int j = 0; j < k; ++j) row += isSpeedHoldEnabled(s, j) ? 1 : 0;
+  return lambda[row];
+}
+
+bool ReducedDenseRows::isSpeedHoldEnabled(const SimTK::State& s, int k) const {
+  const auto& released = SimTK::Value<std::vector<int>>::downcast(forces_->getDiscreteVariable(s, releasedIndex_)).get();
+  return !(k < int(released.size()) && released[k]);
+}
+
+void ReducedDenseRows::setSpeedHoldEnabled(SimTK::State& s, int k, bool enabled) const {
+  auto& released = SimTK::Value<std::vector<int>>::updDowncast(forces_->updDiscreteVariable(s, releasedIndex_)).upd();
+  if (int(released.size()) <= k) released.resize(k + 1, 0);
+  released[k] = enabled ? 0 : 1;
 }
 
 bool ReducedDenseRows::isActive(const SimTK::State& s) const {
@@ -40,6 +57,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
   const SimTK::Vector& u = s.getU();
   rows_.resize(numRows());
   std::size_t i = 0;
+  int k = 0;
   for (const Arm& a : arms_) {
     const int us = a.knuckle.getFirstUIndex(s);
     const double sq = a.knuckle.getOneQ(s, 0), su = u[us];
@@ -71,15 +89,27 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
   for (const Steer& st : steers_) {
     // delta of the knuckle's mobilizer is the angle of (A.1): delta = command.
     RowEval& r = rows_[i++];
-    const SteerCommandValue c = st.command->calcAt(t);
     const int ud = st.knuckle.getFirstUIndex(s) + 1;
-    r.n = 1;
-    r.u[0] = ud, r.g[0] = 1;
-    r.perr = st.knuckle.getOneQ(s, 1) - c.angle_rad;
-    r.verr = u[ud] - c.rate_rad_s;
-    r.b = c.accel_rad_s2 - 2 * w * r.verr - w * w * r.perr;
+    if (st.command) {
+      const SteerCommandValue c = st.command->calcAt(t);
+      r.n = 1;
+      r.u[0] = ud, r.g[0] = 1;
+      r.perr = st.knuckle.getOneQ(s, 1) - c.angle_rad;
+      r.verr = u[ud] - c.rate_rad_s;
+      r.b = c.accel_rad_s2 - 2 * w * r.verr - w * w * r.perr;
+    } else {
+      // State-driven: delta = q_D, q_D'' prescribed (enters through udot0).
+      const int uD = st.steer.getFirstUIndex(s);
+      r.n = 2;
+      r.u[0] = ud, r.g[0] = 1;
+      r.u[1] = uD, r.g[1] = -1;
+      r.perr = st.knuckle.getOneQ(s, 1) - st.steer.getOneQ(s, 0);
+      r.verr = u[ud] - u[uD];
+      r.b = -2 * w * r.verr - w * w * r.perr;
+    }
   }
   for (const Speed& sp : speeds_) {
+    if (!isSpeedHoldEnabled(s, k++)) continue;  // released: the vehicle coasts
     // SpeedHoldImpl's row on the Free mobilizer's u = [w_G, v_G] (chassis
     // origin velocity in Ground): G = (v_xi e_xi + v_eta e_eta) / U0 on v.
     RowEval& r = rows_[i++];
@@ -98,6 +128,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
         (vx * SimTK::dot(SimTK::cross(wG, ex), vG) + vy * SimTK::dot(SimTK::cross(wG, ey), vG)) / U0;
     r.b = -bias - w * r.verr;
   }
+  rows_.resize(i);
 }
 
 std::pair<double, double> ReducedDenseRows::calcRowErrors(const SimTK::State& s) const {

@@ -64,10 +64,14 @@ class WheeledSceneVehicle : public Vehicle {
     Json templates = Json::object();
     for (int ax = 0; ax < car_.numAxles(); ++ax)
       templates[car_.params().axles[ax].name] = car_.suspension(ax).templateName();
+    // The formulation that ran: dense exactly when the state's dense rows are on.
+    const WheeledVehicle::Formulation f = car_.getFormulation();
     return {{"total_mass_kg", car_.totalMass()},
             {"dof", car_.degreesOfFreedom(s)},
             {"assembly_max_body_move_m", assembly_.max_move_m},
-            {"suspensions", templates}};
+            {"suspensions", templates},
+            {"formulation", f.name},
+            {"formulation_why", f.why}};
   }
 
  private:

@@ -42,12 +42,8 @@ WheeledVehicleParams WheeledVehicleParams::withRideHeightSprings(const PluginReg
   p.spring_free_length_from_ride_height = false;
   // The mechanism the springs act in: each axle's assembly template, on Simbody's rows.
   WheeledVehicleParams w = p;
-  w.forward_dynamics = "simbody";
+  w.formulation = "constrained";  // every axle its constrained (assembly) template
   for (AxleParams& a : w.axles) freeLength(a, 0), freeLength(a, 1);  // named errors before any build
-  for (AxleParams& a : w.axles) {
-    const std::string assembly = a.suspension.create(registry)->getAssemblyTemplate();
-    if (!assembly.empty()) a.suspension.block["template"] = assembly;
-  }
   const int n = 2 * int(w.axles.size());
 
   // The vehicle as a scene runs it at rest: every steerable axle held straight

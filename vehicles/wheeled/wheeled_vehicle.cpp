@@ -31,8 +31,9 @@ void WheeledVehicleParams::validate() const {
   }
   makeRoad(road);
   requireNonNegative(gravity_m_per_s2, "vehicle gravity_m_per_s2");
-  if (forward_dynamics != "simbody" && forward_dynamics != "dense")
-    throw Error("vehicle forward_dynamics must be \"simbody\" or \"dense\", got \"" + forward_dynamics + "\"");
+  if (formulation != "auto" && formulation != "constrained" && formulation != "reduced" && formulation != "dense")
+    throw Error("vehicle formulation must be \"auto\", \"constrained\", \"reduced\" or \"dense\", got \"" + formulation +
+                "\"");
 }
 
 const AxleParams& WheeledVehicleParams::axle(const std::string& name) const {
@@ -149,9 +150,12 @@ const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
                    "true: every corner spring's free length is set so that the vehicle at rest sits at its "
                    "tabulated (design) configuration, each spring at its design length; the data's free lengths are "
                    "the start")
-          .string("forward_dynamics", &P::forward_dynamics,
-                  "simbody | dense (every axle double_wishbone_reduced: the constraint rows solved as one dense "
-                  "system)");
+          .string("formulation", &P::formulation,
+                  "auto | constrained | reduced | dense: the form of every axle's mechanism. constrained: the loops "
+                  "closed by Simbody's constraint rows (the reference); reduced: the loops solved in the tree "
+                  "(each template's reduced form); dense: reduced, with every constraint row solved as one dense "
+                  "system; auto: dense when every axle's template has a reduced form and the scene's rows are all "
+                  "dense ones, else reduced, else constrained (the run's summary says which and why)");
   return t;
 }
 
@@ -169,10 +173,42 @@ WheeledVehicleParams WheeledVehicleParams::fromFile(const std::string& path, con
 
 WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params) : WheeledVehicle(params, vehiclePlugins()) {}
 
+namespace {
+
+void useSimbodyRowsOf(const Scene& scene, const ReducedDenseRows* dense, SimTK::State& s);
+
+/// Sets every axle's template to the form `p.formulation` asks (auto: the
+/// reduced form if every axle has one, else the constrained); returns the
+/// form and why. Throws Error naming the axle when "reduced" or "dense" is
+/// asked of a template without a reduced form.
+WheeledVehicle::Formulation resolveTemplates(WheeledVehicleParams& p, const PluginRegistry& registry) {
+  const std::string asked = "asked (formulation \"" + p.formulation + "\")";
+  std::vector<std::string> reduced, constrained;
+  std::string blocker;
+  for (const AxleParams& a : p.axles) {
+    const std::unique_ptr<Suspension> susp = a.suspension.create(registry);
+    std::string whyNot;
+    reduced.push_back(susp->getReducedTemplate(&whyNot));
+    constrained.push_back(susp->getConstrainedTemplate());
+    if (reduced.back().empty() && blocker.empty()) blocker = "axle '" + a.name + "''s template " + whyNot;
+    if (reduced.back().empty() && (p.formulation == "reduced" || p.formulation == "dense"))
+      throw Error("vehicle formulation \"" + p.formulation + "\": axle '" + a.name + "''s template " + whyNot +
+                  " (formulation \"constrained\" or \"auto\" runs it)");
+  }
+  const bool useReduced = p.formulation != "constrained" && blocker.empty();
+  for (std::size_t i = 0; i < p.axles.size(); ++i)
+    p.axles[i].suspension.block["template"] = useReduced ? reduced[i] : constrained[i];
+  if (useReduced) return {"reduced", p.formulation == "auto" ? "every axle's template has a reduced form" : asked};
+  return {"constrained", p.formulation == "auto" ? blocker : asked};
+}
+
+}  // namespace
+
 WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginRegistry& registry)
     : p_(params.spring_free_length_from_ride_height ? params.withRideHeightSprings(registry) : params),
       scene_(std::make_unique<Scene>()) {
   p_.validate();
+  templates_ = resolveTemplates(p_, registry);
   Scene& sc = *scene_;
   SimTK::Force::Gravity(sc.updForces(), sc.updMatter(), -SimTK::UnitVec3(SimTK::ZAxis), p_.gravity_m_per_s2);
   chassis_ = SimTK::MobilizedBody::Free(sc.updMatter().Ground(), SimTK::Transform(), makeRigidBody(p_.chassis),
@@ -229,13 +265,13 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
   // Rows the templates gather into one constraint object for the whole vehicle.
   std::vector<ArmPlanesImpl::Row> rows;
   bool dense = true;
-  for (const Axle& a : axles_)
+  for (const Axle& a : axles_) {
     for (int side = 0; side < 2; ++side) {
       const auto r = a.suspension->getArmRows(side);
       rows.insert(rows.end(), r.begin(), r.end());
-      ReducedDenseRows::Arm arm;
-      dense = dense && a.suspension->getDenseArm(side, &arm);
     }
+    dense = dense && a.suspension->supportsDenseRows();
+  }
   if (!rows.empty()) SimTK::Constraint::Custom(new ArmPlanesImpl(sc.updMatter(), rows));
   for (const Axle& a : axles_)
     if (!a.suspension->getAssemblyTemplate().empty() && !registry_)
@@ -243,14 +279,13 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
   if (dense) {
     dense_ = new ReducedDenseRows(sc.getMatter(), sc.getForces());
     SimTK::Force::Custom(sc.updForces(), dense_);  // inactive until useDenseRows()
-  } else if (p_.forward_dynamics == "dense") {
-    for (const Axle& a : axles_) {
-      ReducedDenseRows::Arm arm;
-      if (!a.suspension->getDenseArm(0, &arm))
-        throw Error("vehicle forward_dynamics \"dense\" needs every axle's suspension template to have a dense "
-                    "formulation (double_wishbone_reduced); axle '" + p_.axles[&a - axles_.data()].name +
-                    "' is " + a.suspension->templateName());
-    }
+    auto service = std::make_shared<ConstraintRowsService>();
+    const Scene* scene = scene_.get();
+    const ReducedDenseRows* rows = dense_;
+    service->use_simbody_rows = [scene, rows](SimTK::State& s) { useSimbodyRowsOf(*scene, rows, s); };
+    sc.setService<const ConstraintRowsService>(kConstraintRowsService, service);
+  } else if (templates_.name == "reduced" && p_.formulation == "dense") {
+    throw Error("vehicle formulation \"dense\": a reduced template has no dense rows");
   }
   addChassisOutputs(sc, chassis_);
 }
@@ -359,13 +394,8 @@ SimTK::State WheeledVehicle::makeInitialState(double speed, AssemblyReport* repo
   // Axles that start from another template's assembly: a copy of the vehicle
   // with those templates, its axle steering held at its initial angles.
   WheeledVehicleParams cp = p_;
-  cp.forward_dynamics = "simbody";
-  for (int ax = 0; ax < numAxles(); ++ax) {
-    const std::string t = suspension(ax).getAssemblyTemplate();
-    if (t.empty()) continue;
-    cp.axles[ax].suspension.block["template"] = t;
-    copied = true;
-  }
+  cp.formulation = "constrained";  // every axle its constrained (assembly) template
+  for (int ax = 0; ax < numAxles(); ++ax) copied = copied || !suspension(ax).getAssemblyTemplate().empty();
   if (copied) {
     WheeledVehicle con(cp, *registry_);
     for (const AxleSteering& a : axleSteering_)
@@ -421,7 +451,7 @@ SimTK::State WheeledVehicle::makeInitialState(double speed, AssemblyReport* repo
   for (int c = 0; c < n; ++c) scene_->getBody(cornerName(c) + ".wheel").setOneU(s, 0, spin[c]);
   system.realize(s, SimTK::Stage::Velocity);
   for (const TirePlugin* t : tires_) t->getForceElement().initializeRelaxationStates(s);
-  if (p_.forward_dynamics == "dense") {
+  if (getFormulation().name == "dense") {
     useDenseRows(s);
     system.realize(s, SimTK::Stage::Velocity);
   }
@@ -498,55 +528,94 @@ SimTK::State WheeledVehicle::makeStateLike(const WheeledVehicle& other, const Si
   s.updZ() = os.getZ();
   system.realize(s, SimTK::Stage::Position);
   system.project(s, 1e-12);
-  if (p_.forward_dynamics == "dense") useDenseRows(s);
+  if (getFormulation().name == "dense") useDenseRows(s);
   system.realize(s, SimTK::Stage::Velocity);
   return s;
 }
 
-void WheeledVehicle::useDenseRows(SimTK::State& s) const {
-  if (!dense_) {
-    for (int ax = 0; ax < numAxles(); ++ax) {
-      ReducedDenseRows::Arm arm;
-      if (!suspension(ax).getDenseArm(0, &arm))
-        throw Error("vehicle: dense forward dynamics needs every axle's suspension template to have a dense "
-                    "formulation (double_wishbone_reduced); axle '" + p_.axles[ax].name + "' is " +
-                    suspension(ax).templateName());
-    }
-  }
+WheeledVehicle::Formulation WheeledVehicle::getFormulation() const {
+  if (templates_.name != "reduced") return templates_;
+  if (p_.formulation == "reduced") return templates_;
+  if (p_.formulation == "dense") return {"dense", templates_.why};
+  std::string whyNot;
+  if (!collectDenseRows(nullptr, nullptr, nullptr, &whyNot)) return {"reduced", "not dense: " + whyNot};
+  return {"dense", "every axle's template supports it"};
+}
+
+bool WheeledVehicle::collectDenseRows(std::vector<ReducedDenseRows::Arm>* arms,
+                                      std::vector<ReducedDenseRows::Steer>* steers,
+                                      std::vector<const SpeedHoldPlugin*>* speeds, std::string* whyNot) const {
+  auto fail = [&](const std::string& why) {
+    *whyNot = why;
+    return false;
+  };
+  for (int ax = 0; ax < numAxles(); ++ax)
+    if (!suspension(ax).supportsDenseRows())
+      return fail("axle '" + p_.axles[ax].name + "''s template " + suspension(ax).templateName() + " has no dense rows");
   const Scene& sc = *scene_;
-  std::vector<ReducedDenseRows::Arm> arms;
   for (int c = 0; c < numCorners(); ++c) {
     ReducedDenseRows::Arm arm;
     suspension(c / 2).getDenseArm(c % 2, &arm);
-    arms.push_back(arm);
+    if (arms) arms->push_back(arm);
   }
-  std::vector<ReducedDenseRows::Steer> steers;
-  std::vector<ReducedDenseRows::Speed> speeds;
-  const std::string why = " (forward_dynamics \"dense\" solves only time-commanded steering of the knuckles and "
-                          "speed holds on the chassis; use forward_dynamics \"simbody\")";
+  int nRows = 2 * numCorners();
   for (const auto& plugin : sc.getPlugins()) {
     if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get())) {
-      if (st->isStateDriven()) throw Error("vehicle: steering plugin '" + plugin->name() + "' is state-driven" + why);
-      if (st->drivesRack()) throw Error("vehicle: steering plugin '" + plugin->name() + "' drives a rack" + why);
+      if (st->drivesRack()) return fail("steering plugin '" + plugin->name() + "' drives a rack");
+      // Simbody projects its rows onto the new velocity level when a
+      // command's rate jumps (the integrator restarts there); the dense rows
+      // are only held by their Baumgarte terms and would lag the jump.
+      if (st->sharedCommand() && !st->sharedCommand()->getRateJumpTimes().empty())
+        return fail("steering plugin '" + plugin->name() + "''s command has rate jumps (the dense rows are not "
+                    "projected at a jump)");
       if (sc.getBody(st->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
-        throw Error("vehicle: steering plugin '" + plugin->name() + "' is not on the chassis" + why);
+        return fail("steering plugin '" + plugin->name() + "' is not on the chassis");
       for (const std::string& k : st->knuckleBodies()) {
         int c = 0;
         while (c < numCorners() && cornerName(c) + ".knuckle" != k) ++c;
-        if (c == numCorners()) throw Error("vehicle: steering plugin '" + plugin->name() + "' steers '" + k + "', not a knuckle" + why);
+        if (c == numCorners()) return fail("steering plugin '" + plugin->name() + "' steers '" + k + "', not a knuckle");
         if ((st->spinAxis().asVec3() - suspension(c / 2).getSpinAxis(c % 2).asVec3()).norm() > 1e-12)
-          throw Error("vehicle: steering plugin '" + plugin->name() + "' measures (A.1) about another spin axis than " + k +
-                      "'s" + why);
-        steers.push_back({reducedCorner(c).knuckle, st->sharedCommand()});
+          return fail("steering plugin '" + plugin->name() + "' measures (A.1) about another spin axis than " + k + "'s");
+        if (steers)
+          steers->push_back({reducedCorner(c).knuckle, st->sharedCommand(),
+                             st->isStateDriven() ? SimTK::MobilizedBody(st->getSteerBody()) : SimTK::MobilizedBody()});
+        ++nRows;
       }
     } else if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get())) {
       if (sc.getBody(sp->chassisBody()).getMobilizedBodyIndex() != chassis_.getMobilizedBodyIndex())
-        throw Error("vehicle: speed hold '" + plugin->name() + "' is not on the chassis" + why);
-      const ReducedDenseRows* dense = dense_;
-      const int k = int(speeds.size());
-      sp->setDisabledForceSource([dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); });
-      speeds.push_back({chassis_, sp});
+        return fail("speed hold '" + plugin->name() + "' is not on the chassis");
+      if (speeds) speeds->push_back(sp);
+      ++nRows;
     }
+  }
+  // Every other constraint of the scene (another plugin's, a body lock's) is
+  // one the dense system does not solve: one Constraint object per knuckle
+  // row, one per speed hold, the vehicle's one ArmPlanesImpl.
+  const int nConstraints = sc.getMatter().getNumConstraints();
+  if (nConstraints != nRows - 2 * numCorners() + 1)
+    return fail("the scene has " + std::to_string(nConstraints) + " constraint objects, the dense rows account for " +
+                std::to_string(nRows - 2 * numCorners() + 1) + " (a plugin adds a constraint the dense system does "
+                "not solve)");
+  return true;
+}
+
+void WheeledVehicle::useDenseRows(SimTK::State& s) const {
+  std::vector<ReducedDenseRows::Arm> arms;
+  std::vector<ReducedDenseRows::Steer> steers;
+  std::vector<const SpeedHoldPlugin*> holds;
+  std::string whyNot;
+  const std::string why = " (the dense rows solve steering of the knuckles, time-commanded or state-driven, and "
+                          "speed holds on the chassis; use formulation \"reduced\" or \"constrained\")";
+  if (!collectDenseRows(&arms, &steers, &holds, &whyNot)) throw Error("vehicle: dense forward dynamics: " + whyNot + why);
+  const Scene& sc = *scene_;
+  std::vector<ReducedDenseRows::Speed> speeds;
+  for (const SpeedHoldPlugin* sp : holds) {
+    const ReducedDenseRows* dense = dense_;
+    const int k = int(speeds.size());
+    sp->setExternalRow({[dense](const SimTK::State& st) { return dense->isActive(st); },
+                        [dense, k](const SimTK::State& st) { return dense->speedHoldForce(st, k); },
+                        [dense, k](SimTK::State& st, bool on) { dense->setSpeedHoldEnabled(st, k, on); }});
+    speeds.push_back({chassis_, sp});
   }
   dense_->setRows(std::move(arms), std::move(steers), std::move(speeds));
   const SimTK::MultibodySystem& system = sc.getSystem();
@@ -559,5 +628,26 @@ void WheeledVehicle::useDenseRows(SimTK::State& s) const {
   for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(s);
   dense_->setActive(s, true);
 }
+
+namespace {
+/// WheeledVehicle::useSimbodyRows on the scene and its dense element (the
+/// scene service holds these, not the vehicle: both live on the heap).
+void useSimbodyRowsOf(const Scene& scene, const ReducedDenseRows* dense, SimTK::State& s) {
+  if (!dense || !dense->isActive(s)) return;
+  std::vector<bool> released;
+  int k = 0;
+  for (const auto& plugin : scene.getPlugins())
+    if (dynamic_cast<const SpeedHoldPlugin*>(plugin.get())) released.push_back(!dense->isSpeedHoldEnabled(s, k++));
+  dense->setActive(s, false);
+  const SimTK::SimbodyMatterSubsystem& m = scene.getMatter();
+  for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).enable(s);
+  k = 0;
+  for (const auto& plugin : scene.getPlugins())
+    if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get()))
+      if (released[k++]) sp->setEnabled(s, false);
+}
+}  // namespace
+
+void WheeledVehicle::useSimbodyRows(SimTK::State& s) const { useSimbodyRowsOf(*scene_, dense_, s); }
 
 }  // namespace vdyn

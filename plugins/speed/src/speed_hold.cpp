@@ -113,6 +113,7 @@ void SpeedHoldPlugin::setSpeed(SimTK::State& s, double U0) const {
 
 void SpeedHoldPlugin::setEnabled(SimTK::State& s, bool enabled) const {
   if (!impl_) throw Error("speed hold '" + name() + "' is not part of a scene yet");
+  if (external_.active && external_.active(s)) return external_.setEnabled(s, enabled);
   if (enabled)
     constraint_.enable(s);
   else
@@ -122,7 +123,7 @@ void SpeedHoldPlugin::setEnabled(SimTK::State& s, bool enabled) const {
 double SpeedHoldPlugin::calcForce(const SimTK::State& s) const {
   // Simbody applies -G^T lambda; along the (unit at U0) direction of travel the
   // force on the chassis is therefore -lambda.
-  if (disabledForce_ && constraint_.isDisabled(s)) return disabledForce_(s);
+  if (external_.active && external_.active(s)) return external_.force(s);
   return -constraint_.getMultipliersAsVector(s)[0];
 }
 

@@ -256,7 +256,10 @@ std::string SteadyStateSolver::describeEquation(int row) const {
 }
 
 SteadyStateResult SteadyStateSolver::solve(const SimTK::State& guess) {
-  const SimTK::State se = toEulerAngles(scene_, guess);
+  SimTK::State g = guess;  // the steady equations take Simbody's rows (their multipliers are unknowns)
+  if (scene_.hasService(kConstraintRowsService))
+    scene_.getService<const ConstraintRowsService>(kConstraintRowsService)->use_simbody_rows(g);
+  const SimTK::State se = toEulerAngles(scene_, g);
   haveJacobian_ = false;
   std::vector<double> p0;
   for (const auto& p : problem_.parameters) p0.push_back(p.get(guess));

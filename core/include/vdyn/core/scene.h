@@ -32,6 +32,16 @@ struct IntegralHandle {
   int index = -1;
 };
 
+/// The scene service kConstraintRowsService: a scene whose states may solve
+/// their constraint rows outside Simbody (a vehicle's dense forward dynamics,
+/// WheeledVehicle::useDenseRows) offers it; `use_simbody_rows` turns such a
+/// state into the same state with Simbody's rows (what a solver that takes the
+/// rows' multipliers as unknowns, the steady-state solver, needs).
+struct ConstraintRowsService {
+  std::function<void(SimTK::State&)> use_simbody_rows;
+};
+inline constexpr const char* kConstraintRowsService = "constraint_rows";
+
 class Scene {
  public:
   Scene();
@@ -58,6 +68,7 @@ class Scene {
     services_[name] = std::shared_ptr<const void>(service);
     serviceTypes_[name] = &typeid(T);
   }
+  bool hasService(const std::string& name) const { return services_.count(name) != 0; }
   template <class T>
   std::shared_ptr<T> getService(const std::string& name) const {
     auto it = services_.find(name);

@@ -12,6 +12,10 @@
 //   upper arm   q_U - theta4(s) = 0      (WishboneLoop::calcUpperArmAngle)
 //   steering    delta - delta_cmd(t) = 0 (the knuckle's delta is the angle of
 //               (A.1) by construction, so this is the steering constraint)
+//   state-driven steering  delta - q_D = 0 (q_D the steer body's angle, whose
+//               Motion prescribes q_D'' = the SteeringLaw's delta'': the
+//               SteeringStateConstraintImpl row x_B . (s_F - y_D) = 0 written
+//               on the reduced coordinates, -sin(delta) = -sin(q_D))
 //   speed hold  (v_xi^2 + v_eta^2 - U0^2) / (2 U0) = 0 (SpeedHoldImpl's row)
 // They are the same constraints as the Simbody rows (a point in the arm's
 // plane through its pivot axis holds exactly when the arm's angle is the
@@ -22,6 +26,11 @@
 //   (G Y) lambda = b - G udot0          (dense Cholesky, m <= 13)
 // and G^T lambda is added to the mobility forces, so Simbody's own tree
 // solve returns udot = udot0 + Y lambda, which meets G udot = b.
+// A prescribed mobility (the steer body's) is not free: udot0 carries its
+// prescribed u' (calcAccelerationIgnoringConstraints obeys Motions) and
+// multiplyByMInv returns 0 there, so its column of G enters G udot0 only and
+// its share of G^T lambda is carried by the Motion's reaction, as the
+// Simbody row's is.
 //
 // Simbody does not know these rows, so it does not project onto them; their
 // drift is held by Baumgarte terms (b - 2 w verr - w^2 perr for the holonomic
@@ -60,9 +69,13 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
     SimTK::MobilizedBody::Custom knuckle;
     const WishboneLoop* loop = nullptr;
   };
+  /// A steered knuckle: time-commanded (`command`), or state-driven (no
+  /// command; `steer` the steering plugin's steer body, whose Motion
+  /// prescribes u' = delta'' from the controller's SteeringLaw).
   struct Steer {
     SimTK::MobilizedBody::Custom knuckle;
     std::shared_ptr<const SteeringCommand> command;
+    SimTK::MobilizedBody steer;
   };
   struct Speed {
     SimTK::MobilizedBody::Free chassis;
@@ -78,8 +91,13 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   /// every row (rad/s; m/s for the speed hold) in `s` (Stage::Velocity).
   std::pair<double, double> calcRowErrors(const SimTK::State& s) const;
   /// Force of the k-th speed hold along the direction of travel, N
-  /// (SpeedHoldPlugin::calcForce's sign), in a dense state (Stage::Dynamics).
+  /// (SpeedHoldPlugin::calcForce's sign), in a dense state (Stage::Dynamics);
+  /// 0 when it is released.
   double speedHoldForce(const SimTK::State& s, int k) const;
+  /// Releases (false) or engages (true) the k-th speed hold's row in a dense
+  /// state (SpeedHoldPlugin::setEnabled; invalidates Stage::Instance).
+  void setSpeedHoldEnabled(SimTK::State& s, int k, bool enabled) const;
+  bool isSpeedHoldEnabled(const SimTK::State& s, int k) const;
 
   // Force::Custom::Implementation
   void calcForce(const SimTK::State&, SimTK::Vector_<SimTK::SpatialVec>&, SimTK::Vector_<SimTK::Vec3>&,
@@ -108,6 +126,7 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   std::vector<Steer> steers_;
   std::vector<Speed> speeds_;
   mutable SimTK::DiscreteVariableIndex activeIndex_;
+  mutable SimTK::DiscreteVariableIndex releasedIndex_;  ///< std::vector<int>: 1 = the k-th hold released
   mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
   // Workspace.
   mutable std::vector<RowEval> rows_;

@@ -134,11 +134,38 @@ class Suspension {
   /// The corner as the dense forward dynamics sees it; false if the template
   /// has no dense formulation (then the vehicle cannot use the dense path).
   virtual bool getDenseArm(int /*side*/, ReducedDenseRows::Arm* /*arm*/) const { return false; }
+  /// True if this template has dense rows (getDenseArm): the vehicle's
+  /// "formulation" "dense" (or "auto") may solve its rows as one dense system.
+  bool supportsDenseRows() const {
+    ReducedDenseRows::Arm arm;
+    return getDenseArm(0, &arm);
+  }
+
+  /// The template of this mechanism's reduced form (its loop solved in the
+  /// tree, with dense rows: the vehicle's "formulation" "reduced", "dense" and
+  /// "auto" build it from the same block): this template's own name if it is
+  /// that form; empty if the mechanism has none, with the reason in `whyNot`
+  /// (e.g. "solid_axle has no reduced form").
+  std::string getReducedTemplate(std::string* whyNot = nullptr) const {
+    std::string why;
+    std::string t = DoGetReducedTemplate(&why);
+    if (t.empty() && whyNot) *whyNot = why.empty() ? templateName() + " has no reduced form" : why;
+    return t;
+  }
+  /// The template of this mechanism's constrained (reference) form, built from
+  /// the same block: getAssemblyTemplate() if it starts from another's
+  /// assembly, else this template.
+  std::string getConstrainedTemplate() const {
+    const std::string a = getAssemblyTemplate();
+    return a.empty() ? templateName() : a;
+  }
 
  protected:
   explicit Suspension(std::string templateName) : template_(std::move(templateName)) {}
   virtual void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) = 0;
   virtual void DoShiftChassisFrame(const SimTK::Vec3& offset_m) = 0;
+  /// See getReducedTemplate(); default: none (the mechanism has no reduced form).
+  virtual std::string DoGetReducedTemplate(std::string* /*whyNot*/) const { return ""; }
   /// The rack given by setRack(); throws Error naming the template if none was.
   const SimTK::MobilizedBody& getRack() const;
 

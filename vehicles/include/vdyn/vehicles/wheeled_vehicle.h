@@ -17,7 +17,7 @@
 //                        "anti_roll_bar": {"template": "torsion_bar", ...},  // optional
 //                        "steering": {"template": "rack_and_pinion", ...}},   // optional: a rack
 //              "rear": {...}},
-//    "road": {...}, "gravity_m_per_s2": 9.81, "forward_dynamics": "simbody"}
+//    "road": {...}, "gravity_m_per_s2": 9.81, "formulation": "auto"}
 // Axles are ordered front to rear by their wheel centres' xi; a corner's
 // bodies are prefixed "<r|l><first letter of the axle>." ("rf.", "lr.") unless
 // the axle gives "prefixes": ["rf", "lf"].
@@ -84,13 +84,22 @@ struct WheeledVehicleParams {
   std::vector<AxleParams> axles;         ///< front to rear
   RoadParams road;                       ///< flat by default
   double gravity_m_per_s2 = 9.81;        ///< along -z, m/s^2
-  /// Data-file key "forward_dynamics": "simbody" (default; the constraint
-  /// rows solved by Simbody, projected each step) or "dense" (every axle's
-  /// template must have a dense formulation, double_wishbone_reduced: the
-  /// rows solved as one dense system per evaluation, with Baumgarte drift
-  /// control; time-commanded steering only; see reduced_dense.h).
-  /// makeInitialState and makeStateLike return dense states.
-  std::string forward_dynamics = "simbody";
+  /// Data-file key "formulation" (scenes: vehicle.overrides.formulation):
+  ///   "constrained": every axle's constrained (reference) template, its loops
+  ///     closed by Simbody's constraint rows, projected each step;
+  ///   "reduced": every axle's reduced template (Suspension::getReducedTemplate:
+  ///     the loop solved in the tree), its rows still Simbody's;
+  ///   "dense": the reduced templates with every constraint row of the scene
+  ///     (arm rows, steering, speed holds) solved as one dense system per
+  ///     evaluation (reduced_dense.h, useDenseRows);
+  ///   "auto" (default): dense when every axle's template has a reduced form
+  ///     and the scene's rows are all ones the dense system solves, reduced
+  ///     when only the templates allow it, else constrained.
+  /// The axles' "template" keys name the mechanism; this key picks its form
+  /// (double_wishbone and double_wishbone_reduced are two forms of one).
+  /// getFormulation() says which ran and why. makeInitialState and
+  /// makeStateLike return states of that formulation.
+  std::string formulation = "auto";
   /// Data key "spring_free_length_from_ride_height" (default false; the
   /// quarter car's key): true sets every corner spring's free length (its
   /// suspension block's spring.free_length_m, and its "left" block's) so that
@@ -200,6 +209,14 @@ class WheeledVehicle {
   const DoubleWishboneCorner& corner(int c) const;
   /// True if every axle is double_wishbone_reduced.
   bool isReduced() const;
+  /// The formulation this vehicle runs with the plugins added so far
+  /// ("constrained", "reduced" or "dense") and why (e.g. "every axle's
+  /// template supports it", "axle 'rear''s template solid_axle has no reduced
+  /// form", "asked (formulation \"constrained\")").
+  struct Formulation {
+    std::string name, why;
+  };
+  Formulation getFormulation() const;
   /// The reduced corner c (throws Error on another template).
   const ReducedWishboneCorner& reducedCorner(int c) const;
   /// Suspension coordinate of a corner (the double wishbone's lower-arm pivot angle, rad).
@@ -211,12 +228,15 @@ class WheeledVehicle {
   /// The arm angles follow from s; the state is projected to the constraints.
   SimTK::State makeStateLike(const WheeledVehicle& other, const SimTK::State& os) const;
   /// Switches `s` to dense forward dynamics (see reduced_dense.h): every
-  /// constraint row of the scene (arm rows, the steering plugins'
-  /// time-commanded rows, speed holds) is disabled in `s` and solved by
+  /// constraint row of the scene (arm rows, the steering plugins' rows, time-
+  /// commanded or state-driven, speed holds) is disabled in `s` and solved by
   /// ReducedDenseRows instead. Throws Error (naming it) if an axle's template
-  /// has no dense formulation or for a row it cannot solve (a state-driven
-  /// steering plugin, any other constraint). Call after every plugin has been added.
+  /// has no dense formulation or for a row it cannot solve (a rack, any other
+  /// constraint). Call after every plugin has been added.
   void useDenseRows(SimTK::State& s) const;
+  /// The reverse of useDenseRows: `s` with Simbody's rows (a released speed
+  /// hold stays released); nothing in a state that is not dense.
+  void useSimbodyRows(SimTK::State& s) const;
   /// The dense rows' force element (null unless every axle supports them).
   const ReducedDenseRows* denseRows() const { return dense_; }
   const TirePlugin& tire(int c) const { return *tires_.at(c); }
@@ -225,6 +245,10 @@ class WheeledVehicle {
 
  private:
   [[noreturn]] void throwNotTemplate(int axle, const char* what) const;
+  /// The dense rows of the scene; false with the reason in `whyNot` if a row
+  /// is not one the dense system solves (`speeds` receives the speed holds).
+  bool collectDenseRows(std::vector<ReducedDenseRows::Arm>* arms, std::vector<ReducedDenseRows::Steer>* steers,
+                        std::vector<const SpeedHoldPlugin*>* speeds, std::string* whyNot) const;
   void requireSteerable(int axle, const std::string& plugin) const;
   WheeledVehicleParams p_;
   std::unique_ptr<Scene> scene_;
@@ -237,6 +261,8 @@ class WheeledVehicle {
   };
   std::vector<Axle> axles_;
   ReducedDenseRows* dense_ = nullptr;  ///< owned by its Force::Custom
+  /// The templates' form chosen when built ("constrained" or "reduced") and why.
+  Formulation templates_;
   std::shared_ptr<const PluginRegistry> registry_;  ///< for the copy an assembly template needs
   struct AxleSteering {
     std::string name;

@@ -84,7 +84,8 @@ void registerDoubleWishboneTemplates(PluginRegistry& registry) {
   registry.addChoice<Suspension>(
       kSuspensionFamily, "double_wishbone_reduced", makeWishbone<ReducedDoubleWishboneSuspension>,
       wishboneInfo("the same double wishbone with the loop solved in the knuckle's mobilizer (q = s, delta): fewer "
-                   "constraint rows, starts from double_wishbone's assembly, supports forward_dynamics \"dense\""));
+                   "constraint rows, starts from double_wishbone's assembly, has dense rows; the vehicle's \"formulation\" "
+                   "builds it from a double_wishbone block (auto, reduced, dense) or the reverse (constrained)"));
 }
 
 
@@ -166,6 +167,16 @@ void DoubleWishboneSuspension::DoBuildCorner(Scene& scene, SimTK::MobilizedBody&
                                        params_[side].tie_rod == "rack" ? &getRack() : nullptr);
   addSpringMount(scene, side, prefix, springMount(chassis, corners_[side].lower_arm, params_[side]),
                  params_[side].stops);
+}
+
+std::string DoubleWishboneSuspension::DoGetReducedTemplate(std::string* whyNot) const {
+  for (const DoubleWishboneParams& p : params_)
+    if (p.tie_rod != "none") {
+      *whyNot = templateName() + " with tie_rod \"" + p.tie_rod +
+                "\" has no reduced form (the reduced knuckle's steering angle is a mobility)";
+      return "";
+    }
+  return "double_wishbone_reduced";
 }
 
 // --- double_wishbone_reduced -------------------------------------------------

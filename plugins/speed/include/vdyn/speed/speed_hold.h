@@ -66,11 +66,15 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   /// Stage::Acceleration).
   double calcForce(const SimTK::State& s) const;
   /// For a model that solves this row itself with the constraint disabled in
-  /// its states (WheeledVehicle::useDenseRows): calcForce reads the force from
-  /// `force` (N, same sign) in a state where the constraint is disabled.
-  void setDisabledForceSource(std::function<double(const SimTK::State&)> force) const {
-    disabledForce_ = std::move(force);
-  }
+  /// its states (WheeledVehicle::useDenseRows): in a state where `active` is
+  /// true, calcForce reads the force from `force` (N, same sign; 0 when
+  /// released) and setEnabled releases or engages the row by `setEnabled`.
+  struct ExternalRow {
+    std::function<bool(const SimTK::State&)> active;
+    std::function<double(const SimTK::State&)> force;
+    std::function<void(SimTK::State&, bool)> setEnabled;
+  };
+  void setExternalRow(ExternalRow row) const { external_ = std::move(row); }
 
  protected:
   void DoAddTo(Scene& scene) override;
@@ -86,7 +90,7 @@ class SpeedHoldPlugin : public ConstraintPlugin {
   double U0_;
   SimTK::Constraint::Custom constraint_;
   const SpeedHoldImpl* impl_ = nullptr;
-  mutable std::function<double(const SimTK::State&)> disabledForce_;
+  mutable ExternalRow external_;  ///< set by the vehicle that solves the row (not a work buffer)
 };
 
 /// Registers "speed_hold": {"chassis": "chassis", "speed_m_s": 10}.

@@ -42,6 +42,9 @@ class DoubleWishboneSuspension : public Suspension {
       : Suspension(std::move(name)), params_{right, right.mirrored()} {}
   void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) override;
   void DoShiftChassisFrame(const SimTK::Vec3& offset_m) override;
+  /// "double_wishbone_reduced" when no tie rod holds the knuckles (the reduced
+  /// knuckle's delta is a mobility); none with a tie rod.
+  std::string DoGetReducedTemplate(std::string* whyNot) const override;
   /// The spring's mounts of a built corner: the chassis point and the lower arm's.
   static SpringMount springMount(const SimTK::MobilizedBody& chassis, const SimTK::MobilizedBody& lowerArm,
                                  const DoubleWishboneParams& p);
@@ -72,6 +75,7 @@ class ReducedDoubleWishboneSuspension : public DoubleWishboneSuspension {
 
  protected:
   void DoBuildCorner(Scene& scene, SimTK::MobilizedBody& chassis, int side, const std::string& prefix) override;
+  std::string DoGetReducedTemplate(std::string*) const override { return templateName(); }
 
  private:
   std::unique_ptr<WishboneLoop> loops_[2];
