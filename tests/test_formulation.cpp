@@ -23,17 +23,17 @@ using namespace vdyn;
 
 namespace {
 
-struct SceneRun {
+struct FormulationRun {
   AnalysisResult result;
   std::string formulation;  ///< what the built vehicle ran
 };
 
-SceneRun runScene(const std::string& file, const std::string& formulation, std::vector<Override> extra = {}) {
+FormulationRun runFormulation(const std::string& file, const std::string& formulation, std::vector<Override> extra = {}) {
   if (!formulation.empty()) extra.push_back({"vehicle.overrides.formulation", formulation});
   const SceneDescription d = SceneDescription::fromFile(file, standardRegistry(), extra);
   BuiltScene b = d.build();
   const AnalysisContext ctx{d, b, "", {}};
-  SceneRun r{b.analysis->run(ctx), b.vehicleAs<WheeledVehicle>().getFormulation().name};
+  FormulationRun r{b.analysis->run(ctx), b.vehicleAs<WheeledVehicle>().getFormulation().name};
   return r;
 }
 
@@ -74,8 +74,8 @@ double maxAbs(const std::vector<double>& a) {
 // 1e-10 reference, constrained and dense (ch3_work_precision); so the two
 // histories are within 2e-6 of each other. The auto vehicle runs dense.
 TEST(Formulation, Ch3TransientDenseAgreesWithConstrained) {
-  const SceneRun con = runScene("scenes/ch3_transient.json", "constrained");
-  const SceneRun au = runScene("scenes/ch3_transient.json", "");
+  const FormulationRun con = runFormulation("scenes/ch3_transient.json", "constrained");
+  const FormulationRun au = runFormulation("scenes/ch3_transient.json", "auto");
   EXPECT_EQ(con.formulation, "constrained");
   EXPECT_EQ(au.formulation, "dense");
   EXPECT_EQ(au.result.summary["vehicle"]["formulation"], "dense");
@@ -93,8 +93,8 @@ TEST(Formulation, Ch3TransientDenseAgreesWithConstrained) {
 // agree to far below the transient's 1e-6; the bound 1e-8 (relative) leaves
 // the Jacobian's conditioning (the residual is in N, the unknowns in m, rad).
 TEST(Formulation, Ch3SteadyStateDenseAgreesWithConstrained) {
-  const SceneRun con = runScene("scenes/ch3_steady_state.json", "constrained");
-  const SceneRun au = runScene("scenes/ch3_steady_state.json", "");
+  const FormulationRun con = runFormulation("scenes/ch3_steady_state.json", "constrained");
+  const FormulationRun au = runFormulation("scenes/ch3_steady_state.json", "auto");
   EXPECT_EQ(au.formulation, "dense");
   for (const char* k : {"chassis.yaw_rate_rad_s", "chassis.roll_rad", "chassis.side_slip_rad"}) {
     const double a = au.result.summary["steady"][k].get<double>(), b = con.result.summary["steady"][k].get<double>();
@@ -109,8 +109,8 @@ TEST(Formulation, Ch3SteadyStateDenseAgreesWithConstrained) {
 TEST(Formulation, Ch8StateDrivenSteeringDenseAgreesWithConstrained) {
   for (const char* strategy : {"nonlinear", "linear", "2ws"}) {
     const std::vector<Override> o = {{"plugins.rear_control.strategy", strategy}};
-    const SceneRun con = runScene("scenes/ch8_maneuvers.json", "constrained", o);
-    const SceneRun au = runScene("scenes/ch8_maneuvers.json", "", o);
+    const FormulationRun con = runFormulation("scenes/ch8_maneuvers.json", "constrained", o);
+    const FormulationRun au = runFormulation("scenes/ch8_maneuvers.json", "auto", o);
     EXPECT_EQ(au.formulation, "dense") << strategy;
     const Table &tc = tableOf(con.result, "history"), &ta = tableOf(au.result, "history");
     const auto dc = columnOf(tc, "path_control.path_distance_m"), da = columnOf(ta, "path_control.path_distance_m");
