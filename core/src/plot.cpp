@@ -68,7 +68,7 @@ std::string range(double lo, double hi) {
 
 /// The gnuplot commands of one panel; `curve` numbers the unwrapping
 /// variables across a figure.
-std::string panelScript(const PlotSpec& p, const CsvOf& csvOf, int& curve) {
+std::string panelScript(const PlotSpec& p, const CsvOf& csvOf, int& curve, bool key = true) {
   std::string s = "unset arrow\nunset label\nunset logscale\nset size noratio\n";
   s += "set title " + gnuplotQuote(p.title) + " noenhanced\nset xlabel " + gnuplotQuote(p.xlabel) +
        " noenhanced\nset ylabel " + gnuplotQuote(p.ylabel) + " noenhanced\n";
@@ -84,7 +84,7 @@ std::string panelScript(const PlotSpec& p, const CsvOf& csvOf, int& curve) {
     s += "set label " + std::to_string(m) + " " + gnuplotQuote(k.label) + " at " + num(k.x) +
          ", graph 0.96 right offset -0.5,0 noenhanced tc rgb 'gray30'\n";
   }
-  s += p.series.size() > 1 ? "set key below horizontal noenhanced\n" : "set key off\n";
+  s += key && p.series.size() > 1 ? "set key below horizontal noenhanced\n" : "set key off\n";
   std::string plot;
   for (std::size_t i = 0; i < p.series.size(); ++i) {
     const PlotSeries& q = p.series[i];
@@ -163,7 +163,15 @@ void renderFigure(const PlotSpec& f, const std::string& png, const CsvOf& csvOf)
         std::to_string(380 * nr + 50) + " font 'sans,10'\nset output " + gnuplotQuote(png) + "\n" + s +
         "set multiplot layout " + std::to_string(nr) + "," + std::to_string(nc) + " title " + gnuplotQuote(f.title) +
         " noenhanced\n";
-    for (const PlotSpec& p : f.panels) s += panelScript(p, csvOf, curve);
+    // A legend once for a run of panels with the same series labels (a
+    // sweep's panels), on the first of them.
+    std::vector<std::string> previous;
+    for (const PlotSpec& p : f.panels) {
+      std::vector<std::string> labels;
+      for (const PlotSeries& q : p.series) labels.push_back(q.label.empty() ? q.y : q.label);
+      s += panelScript(p, csvOf, curve, labels != previous);
+      previous = labels;
+    }
     s += "unset multiplot\n";
   }
   writeFileAtomic(png + ".gp", s);

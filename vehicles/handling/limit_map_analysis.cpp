@@ -11,8 +11,6 @@
 #include <cmath>
 #include <ctime>
 
-#include "vdyn/core/file_io.h"
-#include "vdyn/core/plot.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/handling/limit_map.h"
 #include "vdyn/vehicles/handling_vehicles.h"
@@ -56,50 +54,35 @@ Json pointJson(const LimitMapPoint& p) {
   return j;
 }
 
-/// One PNG, two panels: (speed, front angle) and (speed, lateral
+/// The figure, two panels: (speed, front angle) and (speed, lateral
 /// acceleration), a fold curve per strategy with its stable region shaded
-/// (gnuplot filledcurves down to 0), from the tables as written to out_dir
-/// (Table::writeCsv, the one writer: runScene writes the same bytes again).
-/// The script is kept next to the PNG (limit_map.png.gp), as renderPlots does.
-void plotMap(const std::string& dir, AnalysisResult& res) {
-  if (dir.empty()) return;
-  if (!gnuplotAvailable())
-    throw Error("limit_map: gnuplot not found: the limit map plot needs it (apt-get install gnuplot-nox)");
-  const std::string png = dir + "/limit_map.png";
-  std::string s = "set terminal pngcairo size 1400,620 font 'sans,10'\nset output " + gnuplotQuote(png) +
-                  "\nset datafile separator ','\nset grid\nset key noenhanced top left\n"
-                  "set multiplot layout 1,2 title \"Handling limit map: fold of the steady turn (shaded: stable "
-                  "steady states on the branch from straight running)\" noenhanced\n";
-  const char* const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
-  for (int panel = 0; panel < 2; ++panel) {
-    const std::string y = panel == 0 ? "front_deg" : "lateral_accel_m_s2";
-    s += std::string("set xlabel \"speed U0 (m/s)\"\nset ylabel ") +
-         (panel == 0 ? "\"front road-wheel angle at the fold (deg)\"" : "\"lateral acceleration at the fold (m/s^2)\"") +
-         "\nplot ";
+/// (filled down to 0; a strategy without a stable point has no shading:
+/// renderPlots leaves out a series without points).
+PlotSpec mapFigure(const AnalysisResult& res) {
+  static const char* const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
+  PlotSpec f;
+  f.name = "limit_map";
+  f.title = "Handling limit map: fold of the steady turn (shaded: stable steady states on the branch from straight "
+            "running)";
+  f.columns = 2;
+  for (const std::string y : {"front_deg", "lateral_accel_m_s2"}) {
+    PlotSpec p;
+    p.xlabel = "speed U0 (m/s)";
+    p.ylabel = y == "front_deg" ? "front road-wheel angle at the fold (deg)" : "lateral acceleration at the fold (m/s^2)";
     for (std::size_t i = 0; i < res.tables.size(); ++i) {
-      const auto& [name, t] = res.tables[i];
-      t.writeCsv(dir + "/" + name + ".csv");
-      const std::string f = gnuplotQuote(dir + "/" + name + ".csv"), c = gnuplotQuote(colours[i % 4]);
+      const std::string& name = res.tables[i].first;
       const std::string label = name.substr(std::string("limit_map_").size());
-      // The stable region only where a point has a stable side (gnuplot fails on a series without points).
-      const auto col = std::size_t(std::find(t.columns.begin(), t.columns.end(), "stable_" + y) - t.columns.begin());
-      const bool anyStable =
-          std::any_of(t.rows.begin(), t.rows.end(), [col](const std::vector<double>& r) { return std::isfinite(r[col]); });
-      s += std::string(i ? ", \\\n     " : "");
-      if (anyStable)
-        s += f + " using (column(\"speed_m_s\")):(column(\"stable_" + y +
-             "\")) with filledcurves y1=0 fs transparent solid 0.2 noborder lc rgb " + c + " title " +
-             gnuplotQuote(label + ": stable") + ", \\\n     ";
-      s += f + " using (column(\"speed_m_s\")):(column(\"" + y + "\")) with linespoints lw 2 pt 7 ps 0.6 lc rgb " + c +
-           " title " + gnuplotQuote(label + ": fold");
+      const std::string c = std::string(" lc rgb '") + colours[i % 4] + "'";
+      PlotSeries stable{name, "speed_m_s", "stable_" + y, label + ": stable"};
+      stable.style = "with filledcurves y1=0 fs transparent solid 0.2 noborder" + c;
+      PlotSeries fold{name, "speed_m_s", y, label + ": fold"};
+      fold.style = "with linespoints lw 2 pt 7 ps 0.6" + c;
+      p.series.push_back(stable);
+      p.series.push_back(fold);
     }
-    s += "\n";
+    f.panels.push_back(p);
   }
-  s += "unset multiplot\n";
-  writeFileAtomic(png + ".gp", s);
-  runGnuplot(png + ".gp", png);
-  res.files.push_back(png);
-  res.files.push_back(png + ".gp");
+  return f;
 }
 
 class LimitMapAnalysis : public Analysis {
@@ -180,7 +163,7 @@ class LimitMapAnalysis : public Analysis {
                         {"cpu_time_s", m.cpu_time_s},
                         {"points", pts}};
     }
-    plotMap(ctx.out_dir, res);
+    res.plots.push_back(mapFigure(res));
     res.summary = {{"strategies", strategies_},
                    {"maps", maps},
                    {"wall_time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count()},

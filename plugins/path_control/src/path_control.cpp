@@ -3,6 +3,7 @@
 #include "vdyn/core/fields.h"
 
 #include <cmath>
+#include <functional>
 
 namespace vdyn {
 
@@ -158,22 +159,20 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
 
 // ---------------------------------------------------------------------------
 namespace {
-/// One horizontal component a of the tracked point's acceleration through a
-/// first-order lag: a z variable with a' = (x'' - a) / tau. Its value is read
-/// from z directly (no cache entry: z can change without Stage::Time being
-/// invalidated). The derivative is set while the force subsystem realizes
-/// Acceleration, after Simbody has computed the matter's accelerations.
-class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
+/// A first-order lag: a z variable with z' = (input(s) - z) / tau, its
+/// value read from z directly (no cache entry: z can change without
+/// Stage::Time being invalidated). The derivative is set while the force
+/// subsystem realizes Acceleration, after Simbody has computed the matter's
+/// accelerations, so `input` may need any stage up to Acceleration. Used for
+/// the tracked point's lagged acceleration (x'' -> a) and the two stages of
+/// the feed-forward filter (delta_ss -> g -> f; header).
+class FirstOrderLagMeasure : public SimTK::Measure_<SimTK::Real> {
  public:
+  using Input = std::function<double(const SimTK::State&)>;
   class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
    public:
-    Implementation(const SimTK::MobilizedBody& body, const Vec3& station, int axis, double tau)
-        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0),
-          matter_(&body.getMatterSubsystem()),
-          body_(body.getMobilizedBodyIndex()),
-          station_(station),
-          axis_(axis),
-          tau_(tau) {}
+    Implementation(Input input, double tau)
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0), input_(std::move(input)), tau_(tau) {}
     Implementation* cloneVirtual() const override { return new Implementation(*this); }
     int getNumTimeDerivativesVirtual() const override { return 0; }
     SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
@@ -187,87 +186,33 @@ class LaggedAccelerationMeasure : public SimTK::Measure_<SimTK::Real> {
     }
     void initializeVirtual(SimTK::State& s) const override { getSubsystem().updZ(s)[zIndex_] = 0; }
     void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
-      const double a = matter_->getMobilizedBody(body_).findStationAccelerationInGround(s, station_)[axis_];
-      getSubsystem().updZDot(s)[zIndex_] = (a - getSubsystem().getZ(s)[zIndex_]) / tau_;
+      getSubsystem().updZDot(s)[zIndex_] = (input_(s) - getSubsystem().getZ(s)[zIndex_]) / tau_;
     }
 
    private:
-    // The body by index, not by handle: a (reference-counted) handle held by a
-    // measure of the same system kept the whole system alive (LeakSanitizer).
-    const SimTK::SimbodyMatterSubsystem* matter_;
-    SimTK::MobilizedBodyIndex body_;
-    Vec3 station_;
-    int axis_;
+    Input input_;
     double tau_;
     mutable SimTK::ZIndex zIndex_;
   };
-  LaggedAccelerationMeasure(SimTK::Subsystem& sub, Implementation* impl)
-      : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
+  FirstOrderLagMeasure(SimTK::Subsystem& sub, Input input, double tau)
+      : SimTK::Measure_<SimTK::Real>(sub, new Implementation(std::move(input), tau),
+                                     SimTK::AbstractMeasure::SetHandle()) {}
 };
 
-/// One stage of the feed-forward's filter (header): a z variable with
-/// z' = (input - z) / tau_ff, the input the first stage's value g (second
-/// stage, f) or delta_ss from calcFeedforwardTarget on the tracked point's
-/// position and velocity and the rear angle (first stage, g). Value read
-/// from z as the lagged acceleration's; the derivative set while the force
-/// subsystem realizes Acceleration (the inputs need only Stage::Velocity).
-class FeedforwardFilterMeasure : public SimTK::Measure_<SimTK::Real> {
- public:
-  class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
-   public:
-    Implementation(const SimTK::MobilizedBody& body, const Vec3& station, std::shared_ptr<const ReferencePath> path,
-                   const PathFeedforwardParams& ff, const SteeringActuator* rear, SimTK::Measure input)
-        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0),
-          input_(input),
-          matter_(&body.getMatterSubsystem()),
-          body_(body.getMobilizedBodyIndex()),
-          station_(station),
-          path_(std::move(path)),
-          ff_(ff),
-          rear_(rear) {}
-    Implementation* cloneVirtual() const override { return new Implementation(*this); }
-    int getNumTimeDerivativesVirtual() const override { return 0; }
-    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
-    const SimTK::Real& getUncachedValueVirtual(const SimTK::State& s, int derivOrder) const override {
-      assert(derivOrder == 0);
-      (void)derivOrder;
-      return getSubsystem().getZ(s)[zIndex_];
-    }
-    void realizeMeasureTopologyVirtual(SimTK::State& s) const override {
-      zIndex_ = getSubsystem().allocateZ(s, SimTK::Vector(1, 0.0));
-    }
-    void initializeVirtual(SimTK::State& s) const override { getSubsystem().updZ(s)[zIndex_] = 0; }
-    void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
-      double target = 0;
-      if (!input_.isEmptyHandle()) {
-        target = input_.getValue(s);
-      } else {
-        const SimTK::MobilizedBody& b = matter_->getMobilizedBody(body_);
-        const Vec3 p = b.findStationLocationInGround(s, station_), v = b.findStationVelocityInGround(s, station_);
-        target =
-            calcFeedforwardTarget(ff_, *path_, Vec2(p[0], p[1]), Vec2(v[0], v[1]), rear_ ? rear_->getAngle(s) : 0.0);
-      }
-      getSubsystem().updZDot(s)[zIndex_] = (target - getSubsystem().getZ(s)[zIndex_]) / ff_.lag_s;
-    }
-
-   private:
-    SimTK::Measure input_;  // the first stage's value (second stage), or empty: delta_ss
-    const SimTK::SimbodyMatterSubsystem* matter_;  // the body by index (see LaggedAccelerationMeasure)
-    SimTK::MobilizedBodyIndex body_;
-    Vec3 station_;
-    std::shared_ptr<const ReferencePath> path_;
-    PathFeedforwardParams ff_;
-    const SteeringActuator* rear_;  // owned by the same scene
-    mutable SimTK::ZIndex zIndex_;
-  };
-  FeedforwardFilterMeasure(SimTK::Subsystem& sub, Implementation* impl)
-      : SimTK::Measure_<SimTK::Real>(sub, impl, SimTK::AbstractMeasure::SetHandle()) {}
-};
-
+/// One horizontal component (axis 0: x, 1: y) of the tracked point's
+/// acceleration in Ground through a first-order lag: a' = (x'' - a) / tau.
 SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, const Vec3& station, int axis,
                                      double tau) {
-  return LaggedAccelerationMeasure(scene.updForces(),
-                                   new LaggedAccelerationMeasure::Implementation(chassis, station, axis, tau));
+  // The body by index, not by handle: a (reference-counted) handle held by a
+  // measure of the same system kept the whole system alive (LeakSanitizer).
+  const SimTK::SimbodyMatterSubsystem* matter = &chassis.getMatterSubsystem();
+  const SimTK::MobilizedBodyIndex body = chassis.getMobilizedBodyIndex();
+  return FirstOrderLagMeasure(
+      scene.updForces(),
+      [matter, body, station, axis](const SimTK::State& s) {
+        return matter->getMobilizedBody(body).findStationAccelerationInGround(s, station)[axis];
+      },
+      tau);
 }
 }  // namespace
 
@@ -313,10 +258,21 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
     }
     // Two first-order stages g, f (a critically damped second-order filter):
     // f' = (g - f) / tau_ff is continuous where delta_ss steps.
-    stage1 = FeedforwardFilterMeasure(scene.updForces(), new FeedforwardFilterMeasure::Implementation(
-                                                             chassis, p_.tracked_point_m, path_, ff_, rear, {}));
-    filtered = FeedforwardFilterMeasure(scene.updForces(), new FeedforwardFilterMeasure::Implementation(
-                                                               chassis, p_.tracked_point_m, path_, ff_, rear, stage1));
+    const SimTK::SimbodyMatterSubsystem* matter = &chassis.getMatterSubsystem();  // by index (addLaggedAcceleration)
+    const SimTK::MobilizedBodyIndex body = chassis.getMobilizedBodyIndex();
+    const Vec3 station = p_.tracked_point_m;
+    const std::shared_ptr<const ReferencePath> path = path_;
+    const PathFeedforwardParams ff = ff_;
+    stage1 = FirstOrderLagMeasure(
+        scene.updForces(),
+        [matter, body, station, path, ff, rear](const SimTK::State& s) {  // delta_ss (needs Stage::Velocity)
+          const SimTK::MobilizedBody& b = matter->getMobilizedBody(body);
+          const Vec3 p = b.findStationLocationInGround(s, station), v = b.findStationVelocityInGround(s, station);
+          return calcFeedforwardTarget(ff, *path, Vec2(p[0], p[1]), Vec2(v[0], v[1]), rear ? rear->getAngle(s) : 0.0);
+        },
+        ff_.lag_s);
+    filtered = FirstOrderLagMeasure(
+        scene.updForces(), [stage1](const SimTK::State& s) { return stage1.getValue(s); }, ff_.lag_s);
   }
   law_ = std::make_shared<PathController>(name(), p_, path_, chassis, *steer, ax, ay, ff_, rear, stage1, filtered);
   steer->setAccelerationLaw(law_);

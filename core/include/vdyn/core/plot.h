@@ -29,7 +29,8 @@ std::string unitOfColumn(const std::string& column);
 /// The one gnuplot writer (analyses, studies and sweeps draw through it).
 /// Renders `figure` (one panel, or its `panels` in a grid) to `png`, keeping
 /// the script as <png>.gp; `csvPath(table)` names each series' CSV file.
-/// Legends sit below their panel (never over the data); tick labels use at
+/// Legends sit below their panel (never over the data), once for a run of
+/// panels with the same series labels; tick labels use at
 /// most 4 significant digits; markers are dashed vertical lines with their
 /// label. Throws Error if gnuplot is missing or fails.
 void renderFigure(const PlotSpec& figure, const std::string& png,
