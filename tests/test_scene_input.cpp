@@ -159,6 +159,19 @@ TEST(DerivedScene, AnEntryWithABaseNameMergesOverIt) {
   EXPECT_TRUE(s.check().empty());
 }
 
+TEST(DerivedScene, ACommandOfAnotherTypeReplacesTheBlock) {
+  // A merge would keep the hold's angle_rad, an unknown key of a smooth step.
+  const SceneDescription s = derivedScene("retype", R"("plugins": [{"name": "front_steer", "command":
+      {"type": "smooth_step", "initial_rad": 0, "final_rad": 0.03, "start_time_s": 0.2, "duration_s": 0.5}}])");
+  EXPECT_EQ(s.json()["plugins"][0]["command"],
+            Json::parse(R"({"type": "smooth_step", "initial_rad": 0, "final_rad": 0.03, "start_time_s": 0.2, "duration_s": 0.5})"));
+  EXPECT_EQ(s.json()["plugins"][0]["attach"], "front_axle");  // the entry itself is still merged
+  EXPECT_TRUE(s.check().empty());
+  // null deletes a member (RFC 7396), also inside a replaced block.
+  const SceneDescription n = derivedScene("null", R"("plugins": [{"name": "speed_hold", "speed_m_s": null}])");
+  EXPECT_FALSE(n.json()["plugins"][2].contains("speed_m_s"));
+}
+
 TEST(DerivedScene, ANewNameIsAppended) {
   const SceneDescription s = derivedScene(
       "append", R"("plugins": [{"type": "body_force", "name": "push", "attach": "chassis", "force_N": [0, 100, 0]}])");

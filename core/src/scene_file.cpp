@@ -67,9 +67,47 @@ void applyOverride(Json& scene, const Override& o, const std::string& where) {
 // ---------------------------------------------------------------------------
 // SceneDescription
 namespace {
+/// Removes the members a merge patch deletes (null values), recursively.
+Json withoutNulls(const Json& patch) {
+  if (!patch.is_object()) return patch;
+  Json out = Json::object();
+  for (auto it = patch.begin(); it != patch.end(); ++it)
+    if (!it.value().is_null()) out[it.key()] = withoutNulls(it.value());
+  return out;
+}
+
+/// JSON merge patch (RFC 7396) of `patch` over `base`, except that a typed
+/// block is replaced, not merged, when the patch changes its kind: an object
+/// whose "type" (a command, a plugin, an analysis) or "template" (a subsystem)
+/// differs from the base's takes the patch's keys only. Merged, the base's
+/// keys of the old kind would be unknown keys of the new one (a "hold"
+/// command derived from a "smooth_step" would keep start_time_s).
+void mergeTyped(Json& base, const Json& patch) {
+  if (!patch.is_object()) {
+    base = patch;
+    return;
+  }
+  if (!base.is_object()) {
+    base = withoutNulls(patch);
+    return;
+  }
+  for (const char* kind : {"type", "template"}) {
+    if (patch.contains(kind) && base.contains(kind) && patch[kind] != base[kind]) {
+      base = withoutNulls(patch);
+      return;
+    }
+  }
+  for (auto it = patch.begin(); it != patch.end(); ++it) {
+    if (it.value().is_null())
+      base.erase(it.key());
+    else
+      mergeTyped(base[it.key()], it.value());
+  }
+}
+
 /// The base's plugin list with a derived scene's "plugins" merged over it by
 /// name: an entry whose "name" is a base plugin's is merged over that entry
-/// (JSON merge patch), "remove": true removes it, a new name is appended.
+/// (mergeTyped), "remove": true removes it, a new name is appended.
 Json mergePluginsByName(Json base, const Json& derived, const std::string& where) {
   if (!base.is_array()) base = Json::array();
   if (!derived.is_array()) throw Error(where + ": expected an array of plugin entries, got " + derived.dump());
@@ -90,7 +128,7 @@ Json mergePluginsByName(Json base, const Json& derived, const std::string& where
         throw Error(w + ".remove: the base scene has no plugin '" + name + "' to remove");
       base.erase(it);
     } else if (it != base.end()) {
-      it->merge_patch(e);
+      mergeTyped(*it, e);
     } else {
       base.push_back(e);
     }
@@ -99,7 +137,8 @@ Json mergePluginsByName(Json base, const Json& derived, const std::string& where
 }
 
 /// A scene file with "based_on": "<scene>" is that scene with its own keys
-/// merged over it (JSON merge patch), except "analysis", which replaces the
+/// merged over it (mergeTyped: a JSON merge patch that replaces a block whose
+/// "type" or "template" it changes), except "analysis", which replaces the
 /// base's whole (a derived scene runs another analysis on the same scene), and
 /// "plugins", merged by name (mergePluginsByName) unless "plugins_replace": true
 /// says the list replaces the base's.
@@ -124,7 +163,7 @@ Json readSceneWithBase(const std::string& resolved, int depth) {
     j["plugins"] = mergePluginsByName(base.contains("plugins") ? base["plugins"] : Json::array(), j["plugins"],
                                       resolved + ": plugins");
   if (j.contains("plugins")) base.erase("plugins");  // merge_patch would merge nothing into an array anyway
-  base.merge_patch(j);
+  mergeTyped(base, j);
   return base;
 }
 }  // namespace
