@@ -3,7 +3,8 @@
 #   1. --threads 2 and (if an mpirun is given) `mpirun --oversubscribe -n 3 ... --mpi`
 #      give results.csv and results.json equal byte for byte to a serial run;
 #   2. the variation that cannot reach a steady state is a failed row with its reason;
-#   3. running again resumes: nothing is run, the outputs stay the same.
+#   3. running again resumes: nothing is run, the outputs stay the same;
+#   4. its plot draws a panel per speed, the failed 40 m/s one empty and labelled.
 # usage: sweep_cli_test.sh VDYN SWEEP_FILE WORK_DIR [MPIRUN]
 set -euo pipefail
 vdyn=$1 sweep=$2 work=$3 mpirun=${4:-}
@@ -35,4 +36,10 @@ cp "$work/serial/results.csv" "$work/before.csv"
 "$vdyn" sweep "$sweep" --threads 2 --out "$work/serial" --quiet --no-plots | tee "$work/resume.txt"
 grep -q '0 run now (5 from the journal)' "$work/resume.txt" || fail "the resumed sweep ran again"
 cmp "$work/before.csv" "$work/serial/results.csv" || fail "resumed results differ"
+
+# The plot (resumed again, with plots): five panels, the 40 m/s one without a point.
+"$vdyn" sweep "$sweep" --threads 1 --out "$work/serial" --quiet > /dev/null
+[ -s "$work/serial/yaw_rate.png" ] || fail "no yaw_rate.png"
+[ "$(grep -c '^plot ' "$work/serial/yaw_rate.png.gp")" -eq 5 ] || fail "expected 5 panels in yaw_rate.png.gp"
+grep -q '= 40: no point (every row failed' "$work/serial/yaw_rate.png.gp" || fail "the 40 m/s panel is not labelled empty"
 echo "sweep_cli_test: passed"

@@ -84,6 +84,13 @@ std::string panelScript(const PlotSpec& p, const CsvOf& csvOf, int& curve, bool 
     s += "set label " + std::to_string(m) + " " + gnuplotQuote(k.label) + " at " + num(k.x) +
          ", graph 0.96 right offset -0.5,0 noenhanced tc rgb 'gray30'\n";
   }
+  if (p.series.empty()) {
+    // A panel with nothing to draw (a sweep's panel whose every row failed)
+    // keeps its place in the grid, framed and labelled, instead of failing
+    // gnuplot ("all points y value undefined").
+    return s + "set key off\nset xrange [0:1]\nset yrange [0:1]\nset format x ''\nset format y ''\n"
+               "set label 99 \"no point to draw\" at graph 0.5, graph 0.5 center noenhanced\nplot 2 notitle\n";
+  }
   s += key && p.series.size() > 1 ? "set key below horizontal noenhanced\n" : "set key off\n";
   std::string plot;
   for (std::size_t i = 0; i < p.series.size(); ++i) {

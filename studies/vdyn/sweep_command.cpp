@@ -45,22 +45,34 @@ void renderSweepPlots(const SweepDescription& d, const SweepResult& r, const std
   if (d.plots.empty()) return;
   if (!gnuplotAvailable()) throw Error("gnuplot not found: the sweep's plots need it (apt-get install gnuplot-nox)");
   const std::string csv = dir + "/results.csv";
+  // The text of a key's or collected column's value in a row ("" if none).
+  auto fieldOf = [&](const SweepRow& row, const std::string& column) -> std::string {
+    const auto k = std::find(d.keys.begin(), d.keys.end(), column);
+    if (k != d.keys.end()) {
+      const Json* x = d.variations[row.index].find(column);
+      return x ? formatSweepField(*x) : "";
+    }
+    const auto c = std::size_t(std::find(d.collect.begin(), d.collect.end(), column) - d.collect.begin());
+    return row.ok && c < row.values.size() ? formatSweepField(row.values[c]) : "";
+  };
+  // The distinct values of a key or collected column, in row order.
   auto distinct = [&](const std::string& column) {
     std::vector<std::string> v;
     if (column.empty()) return std::vector<std::string>{""};
-    const auto k = std::find(d.keys.begin(), d.keys.end(), column);
     for (const SweepRow& row : r.rows) {
-      std::string text;
-      if (k != d.keys.end()) {
-        const Json* x = d.variations[row.index].find(column);
-        text = x ? formatSweepField(*x) : "";
-      } else {
-        const auto c = std::find(d.collect.begin(), d.collect.end(), column) - d.collect.begin();
-        text = row.ok ? formatSweepField(row.values[std::size_t(c)]) : "";
-      }
+      const std::string text = fieldOf(row, column);
       if (!text.empty() && std::find(v.begin(), v.end(), text) == v.end()) v.push_back(text);
     }
     return v;
+  };
+  // True if a row that succeeded has an x and a y in `panel`'s `series`.
+  auto hasPoint = [&](const SweepPlot& p, const std::string& panel, const std::string& series) {
+    for (const SweepRow& row : r.rows)
+      if (row.ok && (p.panels.empty() || fieldOf(row, p.panels) == panel) &&
+          (p.series.empty() || fieldOf(row, p.series) == series) && !fieldOf(row, p.x).empty() &&
+          !fieldOf(row, p.y).empty())
+        return true;
+    return false;
   };
   for (const SweepPlot& p : d.plots) {
     const auto panels = distinct(p.panels), series = distinct(p.series);
@@ -74,6 +86,11 @@ void renderSweepPlots(const SweepDescription& d, const SweepResult& r, const std
       q.title = p.panels.empty() ? p.title
                                  : (p.panel_label.empty() ? lastSegment(p.panels) : p.panel_label) + " = " + panel;
       for (const std::string& s : series) {
+        // Every panel draws the same series (the same colours and one legend),
+        // less those without a point in any panel; a panel with no point at
+        // all is drawn empty (gnuplot cannot draw it).
+        if (!std::any_of(panels.begin(), panels.end(), [&](const std::string& q) { return hasPoint(p, q, s); }))
+          continue;
         PlotSeries c{csv, p.x, p.y,
                      p.series.empty() ? lastSegment(p.y)
                                       : (p.series_label.empty() ? lastSegment(p.series) : p.series_label) + " = " + s};
@@ -83,6 +100,10 @@ void renderSweepPlots(const SweepDescription& d, const SweepResult& r, const std
         if (!p.series.empty()) c.where.emplace_back(p.series, s);
         c.style = "with linespoints lw 2 pt 7 ps 0.6";
         q.series.push_back(c);
+      }
+      if (!std::any_of(series.begin(), series.end(), [&](const std::string& s) { return hasPoint(p, panel, s); })) {
+        q.series.clear();
+        q.title += ": no point (every row failed; results.csv says why)";
       }
       fig.panels.push_back(q);
     }
