@@ -1,4 +1,4 @@
-// stress: the stress matrix (not a ctest test; see README). It runs scene
+// stress: the stress matrix (not a ctest test; see docs/benchmarks.md, "Stress matrix"). It runs scene
 // files, as `vdyn run` does, with --set style overrides (scene_file.h) for
 // each cell:
 //   quarter car   scenes/quarter_car_sine_road.json (the chapter 4 sine road;

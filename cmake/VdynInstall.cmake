@@ -1,4 +1,4 @@
-# Install and export (README, "Install and use from another project"):
+# Install and export (docs/user_guide.md, "Install and use from another project"):
 #   cmake --install build --prefix P
 # installs the public headers (P/include/vdyn/...), the vdyn libraries (P/lib),
 # the data files (P/share/vdyn/data, found at run time from the installed
@@ -25,7 +25,7 @@ set(VDYN_EXPORTED_LIBRARIES
 # Simbody was built without it; config.h turns it into a compile error). -UNDEBUG
 # comes after CMake's configuration flags (-O3 -DNDEBUG for Release) on the
 # command line, so it wins. Simbody 3.7's headers do not compile as C++20: the
-# project is C++17, and so must its users be (stated in the README).
+# project is C++17, and so must its users be (stated in docs/user_guide.md, "Install and use from another project").
 target_compile_options(vdyn_core INTERFACE -UNDEBUG)
 target_compile_features(vdyn_core PUBLIC cxx_std_17)
 

@@ -26,7 +26,7 @@ void IntegratorSettings::validate() const {
 std::string errorEstimateCaveat(const IntegratorSettings& s) {
   // Measured by build/bin/stress (benchmarks/stress.cpp): the worst cell's
   // relative error against the rk_merson 1e-9 reference over the accuracy
-  // asked for (README "Stress matrix"). A caveat where that exceeded 100; the
+  // asked for (docs/benchmarks.md, "Stress matrix"). A caveat where that exceeded 100; the
   // other methods and settings stayed below it (rk_feldberg 74 at 1e-3, cpodes
   // 30 at 1e-6, rk3 14, rk_merson 3.4).
   if (s.method == "semi_explicit_euler2")

@@ -270,7 +270,7 @@ SweepDescription SweepDescription::fromJson(const Json& j, const std::string& wh
       throw Error(at(where, key) + ": expected a non-empty string, got " + dumpCompact(v));
     return v.get<std::string>();
   };
-  // The one path rule (README, "Files resolve where a reader expects them"):
+  // The one path rule (docs/user_guide.md, "Scene files": "Files resolve where a reader expects them"):
   // relative to the naming file (this sweep file), then along the data path.
   d.scene = str("scene");
   if (!d.scene.empty() && d.scene[0] != '/' && !baseDir.empty()) {

@@ -1,4 +1,4 @@
-// The library's entry points (docs: README, "Write a plugin"): vdyn loads the
+// The library's entry points (docs/plugin_guide.md, "Write a plugin"): vdyn loads the
 // library (a scene's "plugin_libraries" or `vdyn run --plugin PATH`), checks
 // vdyn_plugin_abi_version() against its own VDYN_PLUGIN_ABI_VERSION and calls
 // vdyn_register_plugins with its registry.

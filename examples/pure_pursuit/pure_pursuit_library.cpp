@@ -1,4 +1,4 @@
-// The library's entry points (README, "Write a plugin").
+// The library's entry points (docs/plugin_guide.md, "Write a plugin").
 #include <memory>
 
 #include "pure_pursuit.h"

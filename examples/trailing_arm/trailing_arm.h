@@ -1,5 +1,5 @@
 #pragma once
-// An out-of-tree suspension template (README, "Write a plugin"): the trailing
+// An out-of-tree suspension template (docs/plugin_guide.md, "Write a plugin"): the trailing
 // arm. One arm on a revolute chassis joint whose axis runs through two chassis
 // points (pivot_inner_m, pivot_outer_m, chassis frame); the wheel spins on the
 // arm at spindle_m; a spring-damper from a chassis point to a point on the arm.

@@ -1,4 +1,4 @@
-// The library's entry points (README, "Write a plugin"): a suspension template
+// The library's entry points (docs/plugin_guide.md, "Write a plugin"): a suspension template
 // registered in the registry's suspension_template family.
 #include "trailing_arm.h"
 #include "vdyn/core/plugin_library.h"

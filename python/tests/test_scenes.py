@@ -95,7 +95,7 @@ def test_run_writes_files_only_when_asked(tmp_path):
 
 
 def test_done_criterion_one_liner(cli, tmp_path, root):
-    # The README's command, from another working folder (scenes resolve along the data path).
+    # The user guide's command (docs/user_guide.md, "Python"), from another working folder (scenes resolve along the data path).
     cli("run", "scenes/ch3_transient.json", "--out", str(tmp_path), "--no-plots")
     expected = read_json(tmp_path / "summary.json")["final"]["chassis.yaw_rate_rad_s"]
     code = ("import vdyn; print(vdyn.Scene.from_file('scenes/ch3_transient.json').run()"

@@ -1,6 +1,6 @@
 """vdyn: multibody vehicle dynamics from scene files, in Python.
 
-The same code path as the ``vdyn`` program (README, "Python"): a scene run
+The same code path as the ``vdyn`` program (docs/user_guide.md, "Python"): a scene run
 here gives the CLI's summary bit for bit.
 
     import vdyn

@@ -4,7 +4,9 @@
 // type of that name is printed). `vdyn list outputs SCENE` and `vdyn list
 // attachments SCENE` build the scene and print what its vehicle and plugins
 // provide: every output with its unit and stage, every attachment with its
-// bindings.
+// bindings. `vdyn list --markdown` prints the same field tables as Markdown:
+// docs/scene_reference.md is that output (ctest Docs.SceneReferenceIsCurrent
+// fails when the file and the tables differ).
 #include <algorithm>
 #include <cstdio>
 
@@ -20,12 +22,16 @@ int listCommand(const std::vector<std::string>& args) {
                      "only this kind (vehicle, force_element, constraint, controller, analysis), choice family "
                      "(steering_command, rear_steer_strategy, sensitivity_method, ...) or type name (fourws, gim, "
                      "antiroll_bar, ...); or outputs | attachments with a SCENE")(
-      "scene", po::value<std::string>(), "with outputs | attachments: the scene file whose built scene is listed");
+      "scene", po::value<std::string>(), "with outputs | attachments: the scene file whose built scene is listed")(
+      "markdown", "print the field tables as Markdown (docs/scene_reference.md is `vdyn list --markdown`)");
   addCommonOptions(opts);
   po::variables_map vm;
   if (!parseArgs(command("list"), args, opts, {"kind", "scene"}, vm)) return 0;
   PluginRegistry& registry = registryWithPlugins(vm);
   const std::string what = vm.count("kind") ? vm["kind"].as<std::string>() : "";
+  const bool markdown = vm.count("markdown") > 0;
+  if (markdown && (what == "outputs" || what == "attachments"))
+    throw Error("vdyn list --markdown: prints the registered types' field tables, not a scene's " + what);
   if (what == "outputs" || what == "attachments") {
     if (!vm.count("scene")) throw Error("vdyn list " + what + " SCENE: no scene file given");
     const SceneDescription d = SceneDescription::fromFile(vm["scene"].as<std::string>(), registry);
@@ -55,7 +61,40 @@ int listCommand(const std::vector<std::string>& args) {
   if (vm.count("scene"))
     throw Error("vdyn list: a second argument ('" + vm["scene"].as<std::string>() +
                 "') is only for vdyn list outputs | attachments SCENE");
-  auto printType = [](const std::string& type, const TypeInfo& info) {
+  // Markdown table cells hold the field table's own text: '|' escaped everywhere; in prose cells also '<' (an
+  // HTML tag to a renderer, as in r<N>) and '*' (emphasis); code cells (keys, defaults) keep the rest as written.
+  auto cell = [](const std::string& text, bool code) {
+    std::string out;
+    for (char c : text) {
+      if (c == '|') out += "\\|";
+      else if (!code && c == '<') out += "&lt;";
+      else if (!code && c == '*') out += "\\*";
+      else out += c;
+    }
+    return out;
+  };
+  auto printType = [&](const std::string& type, const TypeInfo& info) {
+    if (markdown) {
+      std::printf("### %s\n\n", type.c_str());
+      if (!info.summary.empty()) std::printf("%s\n\n", info.summary.c_str());
+      if (info.fields.empty()) {
+        std::printf("No keys.\n\n");
+        return;
+      }
+      std::printf("| key | unit | default | meaning |\n|---|---|---|---|\n");
+      for (const auto& f : info.fields) {
+        // "required" and the like are words, not values: only a JSON-looking default is code.
+        const std::string& d = f.default_value;
+        const bool word = d.empty() || d == "required" || d == "none" || (d.find(' ') != std::string::npos &&
+                                                                       d.front() != '{' && d.front() != '[' &&
+                                                                       d.front() != '"');
+        const std::string def = word ? cell(d, false) : "`" + cell(d, true) + "`";
+        std::printf("| `%s` | %s | %s | %s |\n", cell(f.key, true).c_str(),
+                    f.unit.empty() ? "1" : cell(f.unit, false).c_str(), def.c_str(), cell(f.meaning, false).c_str());
+      }
+      std::printf("\n");
+      return;
+    }
     std::printf("  %s%s%s\n", type.c_str(), info.summary.empty() ? "" : " -- ", info.summary.c_str());
     int kw = 4, dw = 7;
     for (const auto& f : info.fields) {
@@ -99,17 +138,31 @@ int listCommand(const std::vector<std::string>& args) {
       onlyType = k;
     }
   }
+  if (markdown)
+    std::printf("# Scene reference\n\n"
+                "Generated from the field tables the loaders read with: `build/bin/vdyn list --markdown > "
+                "docs/scene_reference.md`.\nDo not edit it by hand; ctest `Docs.SceneReferenceIsCurrent` fails when "
+                "it differs from the tables.\nEvery key of every registered kind and choice family, with its SI unit "
+                "(`1` or `-`: none), default and meaning.\nA nested object's keys are listed as `params: key`, a vehicle's "
+                "data-file keys as `data: key`.\nThe scene file format itself: [user guide, \"Scene files\"]"
+                "(user_guide.md#scene-files).\n\n");
   for (PluginKind kind : kinds) {
-    std::printf("%s:\n", toKey(kind));
+    if (markdown)
+      std::printf("## %s\n\n", toKey(kind));
+    else
+      std::printf("%s:\n", toKey(kind));
     for (const auto& type : registry.known(kind))
       if (onlyType.empty() || type == onlyType) printType(type, registry.info(kind, type));
-    std::printf("\n");
+    if (!markdown) std::printf("\n");
   }
   for (const auto& family : families) {
-    std::printf("%s (a choice named inside a plugin or analysis):\n", family.c_str());
+    if (markdown)
+      std::printf("## %s\n\nA choice named inside a plugin or analysis.\n\n", family.c_str());
+    else
+      std::printf("%s (a choice named inside a plugin or analysis):\n", family.c_str());
     for (const auto& type : registry.knownChoices(family))
       if (onlyType.empty() || type == onlyType) printType(type, registry.choiceInfo(family, type));
-    std::printf("\n");
+    if (!markdown) std::printf("\n");
   }
   return 0;
 }

@@ -121,7 +121,7 @@ void renderSweepPlots(const SweepDescription& d, const SweepResult& r, const std
 int sweepCommand(const std::vector<std::string>& args) {
   namespace po = study::po;
   po::options_description opts("Options");
-  opts.add_options()("sweep", po::value<std::string>(), "sweep file (JSON; see the README's \"Sweeps\")")(
+  opts.add_options()("sweep", po::value<std::string>(), "sweep file (JSON; see docs/user_guide.md, \"Sweeps\")")(
       "threads", po::value<int>(),
       "worker threads (default: one per core; with --mpi: threads on rank 0 besides managing, default 1, "
       "0 = rank 0 only manages)")(

@@ -38,7 +38,7 @@ const std::vector<std::string>& integratorNames();
 /// error of vdyn's vehicle scenes, a one-line caveat saying so (with the
 /// measured figure), else "". The figures are the stress matrix's
 /// (build/bin/stress: error of the final yaw rate or cost against an
-/// rk_merson 1e-9 reference, over the accuracy asked for; see README
+/// rk_merson 1e-9 reference, over the accuracy asked for; see docs/benchmarks.md,
 /// "Stress matrix"). simulate() puts the caveat into RunSummary::warnings and
 /// prints it once per process on stderr.
 std::string errorEstimateCaveat(const IntegratorSettings& settings);

@@ -1,7 +1,7 @@
 #pragma once
 // Reading parameter structs from JSON data files.
 //
-// Convention (see README): every key that carries a physical quantity ends in
+// Convention (see docs/design_notes.md, "Conventions"): every key that carries a physical quantity ends in
 // its SI unit, e.g. "mass_kg", "stiffness_N_per_m", "damping_N_s_per_m",
 // "position_m" (a 3-vector). A ParamReader names the file and the key path in
 // every error, e.g. "quarter_car.json: suspension.stiffness_N_per_m: missing key".

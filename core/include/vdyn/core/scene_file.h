@@ -4,7 +4,7 @@
 // kind with their parameters and bindings, the outputs to record and the
 // analysis with its settings -- loaded, validated and run through the registry
 // (registry.h). The format is described, with a complete annotated example, in
-// the README's "Scene files" section:
+// docs/user_guide.md, "Scene files":
 //
 //   {
 //     "name": "ch3_transient",

@@ -3,7 +3,7 @@
 // variation), and a table of chosen quantities from each run's summary.
 //
 //  - SweepDescription: what to run. Read from a sweep file (JSON, strict keys;
-//    format in docs of fromFile below and in the README) or built in C++.
+//    format in docs of fromFile below and in docs/user_guide.md, "Sweeps") or built in C++.
 //    Variations come from a full-factorial grid, an explicit list, a Latin
 //    hypercube or Monte Carlo samples with a seed (SweepRandom: xoshiro256**,
 //    identical on every platform; never std::*_distribution, whose output is

@@ -2,7 +2,7 @@
 // Pseudo-arclength continuation of the solutions of F(x; lambda) = 0 (n
 // equations, n unknowns x, one driving parameter lambda), passing through
 // folds, with step control and test functions for fold and Hopf points
-// (Keller's method as in AUTO-07p / MatCont; docs: README "Continuation").
+// (Keller's method as in AUTO-07p / MatCont; docs/user_guide.md, "Continuation through folds").
 //
 // Scaled variables y = [x / x_scale; lambda / lambda_scale]. From a solution
 // y_k with unit tangent t_k (the null vector of the scaled Jacobian

@@ -3,7 +3,7 @@
 // (n equations, n unknowns x, a first parameter p in which the one-parameter
 // branch folds, a second parameter mu along which the fold is followed), by
 // the minimally augmented system of Govaerts (MatCont's "LP" curve; docs:
-// README "Continuation"):
+// docs/user_guide.md, "Continuation through folds"):
 //     F(x; p, mu) = 0,   g(x; p, mu) = 0,
 // with g the bordered determinant test function of the scaled Jacobian
 // A = diag(r_scale) F_x diag(x_scale):
