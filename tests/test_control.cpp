@@ -227,6 +227,37 @@ TEST(PathFeedforward, SwingDecayRecoversTheDampingOfADampedCosine) {
   EXPECT_EQ(calcSwingDecay(t, std::vector<double>(t.size(), 1.0), 0.0, 5.0, 1e-3).half_swings, 0);
 }
 
+// The free decay after a forced part, with a ripple below the floor: x = 3 +
+// A(t) cos(w_d t) + 2e-4 sin(2 pi 40 t), A growing linearly over the first
+// two periods (the forced entry of a turn) and then exp(-zeta w (t - T)),
+// zeta 0.35 at 1.2 Hz. The decrement starts at the largest half-swing and the
+// ripple's extreme pairs (4e-4 apart, floor 1e-3) are dropped: zeta within
+// 0.005. The first half-swings grow, so reading them as the decay (the
+// estimator of before) gives a negative zeta; a slower second motion after
+// the decay (a growing half-swing) ends it.
+TEST(PathFeedforward, SwingDecayStartsAtTheLargestHalfSwingAndDropsSubFloorWiggles) {
+  const double zeta = 0.35, f = 1.2, w = 2 * SimTK::Pi * f / std::sqrt(1 - zeta * zeta), T = 2 / f;
+  std::vector<double> t, x;
+  for (int i = 0; i <= 6000; ++i) {
+    const double ti = i * 1e-3, amp = ti < T ? ti / T : std::exp(-zeta * w * (ti - T));
+    t.push_back(ti);
+    x.push_back(3 + amp * std::cos(2 * SimTK::Pi * f * ti) + 2e-4 * std::sin(2 * SimTK::Pi * 40 * ti));
+  }
+  const SwingDecay d = calcSwingDecay(t, x, 0.0, 6.0, 1e-3);
+  ASSERT_GE(d.half_swings, 4);
+  EXPECT_NEAR(d.first_extreme_time_s, T, 0.01);
+  EXPECT_NEAR(d.zeta, zeta, 0.005);
+  EXPECT_NEAR(d.frequency_hz, f, 0.01);
+  // A slow swing of 1 from 3 s to its peak at 5 s (larger than the decayed ones): the decay ends before it.
+  std::vector<double> x2 = x;
+  for (std::size_t i = 0; i < t.size(); ++i)
+    if (t[i] > 3.0) x2[i] += 0.5 * (1 - std::cos(2 * SimTK::Pi * 0.25 * (t[i] - 3.0)));
+  const SwingDecay d2 = calcSwingDecay(t, x2, 0.0, 6.0, 1e-3);
+  EXPECT_NEAR(d2.zeta, zeta, 0.01);
+  EXPECT_GE(d2.half_swings, 2);
+  EXPECT_LT(d2.half_swings, d.half_swings);
+}
+
 namespace {
 /// The chapter 8 scene (scenes/ch8_maneuvers.json) on scenario j1 (R 30 m,
 /// 12 m/s), overridden as ch8_maneuvers does, with `gains` and `extra`.
@@ -285,8 +316,10 @@ Ch8Run runCh8JTurn(const Json& gains, const std::vector<Override>& extra, double
 TEST(PathFeedforward, AloneSteersTheLinearBicyclesSteadyAngleOnTheCircle) {
   const Json g = {{"k1_rad_per_s2_per_m", 0}, {"k2_rad_per_s2", 0}, {"k3_rad_per_s2_per_m", 0}, {"k4_rad_per_s2", 0},
                   {"k5_per_s", 10}, {"look_ahead_s", 0.5}, {"tracked_point_m", {0.0, 0.0, -0.64}}};
-  // Stopped at 4.5 s: still on the circle as the feed-forward sees it.
-  const Ch8Run r = runCh8JTurn(g, {}, 4.5);
+  // Stopped at 4.5 s: still on the circle as the feed-forward sees it. No
+  // yaw-rate feedback (K_r = 0): without the errors' integral it would hold
+  // the vehicle's yaw rate at the reference bicycle's, not delta at delta_ss.
+  const Ch8Run r = runCh8JTurn(g, {{"plugins.path_control.yaw_rate_gain_per_s", 0.0}}, 4.5);
   const double expected = (2.27 + 1024.0 / 2.27 * (0.965 - 1.305) / 1.4e5 * 144.0) / 30.0;
   std::printf("feed-forward alone: delta %.5f deg, delta_ss %.5f deg (closed form %.5f deg); yaw rate %.5f rad/s "
               "against U / R %.5f\n", r.end_front_rad * 180 / SimTK::Pi, r.end_target_rad * 180 / SimTK::Pi,
