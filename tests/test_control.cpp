@@ -227,6 +227,35 @@ TEST(PathFeedforward, SwingDecayRecoversTheDampingOfADampedCosine) {
   EXPECT_EQ(calcSwingDecay(t, std::vector<double>(t.size(), 1.0), 0.0, 5.0, 1e-3).half_swings, 0);
 }
 
+// The free decay after a forced part, with a ripple below the floor: for
+// t < T = 1.5 s a ramp from 0 to 1 with a growing 3 Hz swing on it for t < 1 s,
+// t / T + 0.05 t sin(6 pi t) (the forced entry of a turn: its half-swings
+// grow, so reading them as the decay, the estimator of before, gives a
+// negative zeta), then the free decay exp(-zeta w (t - T)) cos(w_d (t - T)),
+// zeta 0.35 at 1.2 Hz; everywhere a ripple 2e-4 sin(2 pi 40 t). The decrement
+// starts at the largest half-swing (the decay's first, at T) and the ripple's
+// extreme pairs (4e-4 apart, floor 1e-3) are dropped: zeta within 0.01.
+TEST(PathFeedforward, SwingDecayStartsAtTheLargestHalfSwingAndDropsSubFloorWiggles) {
+  const double zeta = 0.35, f = 1.2, wd = 2 * SimTK::Pi * f, w = wd / std::sqrt(1 - zeta * zeta), T = 1.5;
+  std::vector<double> t, x;
+  for (int i = 0; i <= 6000; ++i) {
+    const double ti = i * 1e-3;
+    t.push_back(ti);
+    x.push_back((ti < T ? ti / T + (ti < 1 ? 0.05 * ti * std::sin(6 * SimTK::Pi * ti) : 0.0)
+                        : std::exp(-zeta * w * (ti - T)) * std::cos(wd * (ti - T))) +
+                2e-4 * std::sin(2 * SimTK::Pi * 40 * ti));
+  }
+  // The window ends at 3.5 s (ch8_maneuvers ends it 1 s before the turn's exit),
+  // before the decay reaches the ripple's size.
+  const SwingDecay d = calcSwingDecay(t, x, 0.0, 3.5, 1e-3);
+  std::printf("forced then free: %d half-swings from %.3f s, zeta %.4f, %.4f Hz\n", d.half_swings,
+              d.first_extreme_time_s, d.zeta, d.frequency_hz);
+  EXPECT_GE(d.half_swings, 4);
+  EXPECT_NEAR(d.first_extreme_time_s, T, 0.002);
+  EXPECT_NEAR(d.zeta, zeta, 0.01);       // seen 0.3559 (the ripple moves the extremes)
+  EXPECT_NEAR(d.frequency_hz, f, 0.06);  // seen 1.254 Hz
+}
+
 namespace {
 /// The chapter 8 scene (scenes/ch8_maneuvers.json) on scenario j1 (R 30 m,
 /// 12 m/s), overridden as ch8_maneuvers does, with `gains` and `extra`.
@@ -235,7 +264,8 @@ struct Ch8Run {
   double end_lateral_speed_m_s = 0;
   SwingDecay turn;
 };
-Ch8Run runCh8JTurn(const Json& gains, const std::vector<Override>& extra, double t_end_s) {
+Ch8Run runCh8JTurn(const Json& gains, const std::vector<Override>& extra, double t_end_s,
+                   const std::string& strategy = "2ws") {
   const Json lb = {{"mass_kg", 1024.0}, {"front_axle_to_com_m", 1.305}, {"rear_axle_to_com_m", 0.965},
                    {"front_cornering_stiffness_N_per_rad", 1.4e5}, {"rear_cornering_stiffness_N_per_rad", 1.4e5}};
   std::vector<Override> o = {
@@ -244,7 +274,7 @@ Ch8Run runCh8JTurn(const Json& gains, const std::vector<Override>& extra, double
       {"plugins.path_control.path",
        {{"type", "j_turn"}, {"entry_length_m", 18.0}, {"radius_m", 30.0}, {"exit_angle_deg", 90.0}, {"turn", "left"}}},
       {"plugins.path_control.gains", gains},
-      {"plugins.rear_control.strategy", "2ws"},
+      {"plugins.rear_control.strategy", strategy},
       {"plugins.rear_control.linear_bicycle", lb},
       {"plugins.path_control.linear_bicycle", lb}};
   o.insert(o.end(), extra.begin(), extra.end());
@@ -285,8 +315,10 @@ Ch8Run runCh8JTurn(const Json& gains, const std::vector<Override>& extra, double
 TEST(PathFeedforward, AloneSteersTheLinearBicyclesSteadyAngleOnTheCircle) {
   const Json g = {{"k1_rad_per_s2_per_m", 0}, {"k2_rad_per_s2", 0}, {"k3_rad_per_s2_per_m", 0}, {"k4_rad_per_s2", 0},
                   {"k5_per_s", 10}, {"look_ahead_s", 0.5}, {"tracked_point_m", {0.0, 0.0, -0.64}}};
-  // Stopped at 4.5 s: still on the circle as the feed-forward sees it.
-  const Ch8Run r = runCh8JTurn(g, {}, 4.5);
+  // Stopped at 4.5 s: still on the circle as the feed-forward sees it. No
+  // yaw-rate feedback (K_r = 0): without the errors' integral it would hold
+  // the vehicle's yaw rate at the reference bicycle's, not delta at delta_ss.
+  const Ch8Run r = runCh8JTurn(g, {{"plugins.path_control.yaw_rate_gain_per_s", 0.0}}, 4.5);
   const double expected = (2.27 + 1024.0 / 2.27 * (0.965 - 1.305) / 1.4e5 * 144.0) / 30.0;
   std::printf("feed-forward alone: delta %.5f deg, delta_ss %.5f deg (closed form %.5f deg); yaw rate %.5f rad/s "
               "against U / R %.5f\n", r.end_front_rad * 180 / SimTK::Pi, r.end_target_rad * 180 / SimTK::Pi,
@@ -296,28 +328,93 @@ TEST(PathFeedforward, AloneSteersTheLinearBicyclesSteadyAngleOnTheCircle) {
   EXPECT_NEAR(r.end_yaw_rate_rad_s / (12.0 / 30), 1.0, 0.05);
 }
 
-// ch8_maneuvers' j1 (R 30 m, 12 m/s, 2WS) as shipped: within the 0.10 m max /
-// 0.03 m RMS bar with the feed-forward; with "feedforward": "none" and the
-// gains of before it (K5 = 30) the seed's law gives the numbers of before
-// (0.1359 m, 0.0534 m RMS; ch8_maneuvers --feedforward none).
+// ch8_maneuvers' j1 (R 30 m, 12 m/s, 2WS) as shipped (feed-forward, yaw-rate
+// feedback K_r = 40 1/s about the reference bicycle): within the 0.10 m max /
+// 0.03 m RMS bar (0.0627 m, 0.0221 m RMS), and the front angle makes one
+// swing in the turn window, the slow settling (0.142 deg), no second one above
+// 1e-4 deg: the 1.2 Hz swing is gone. With K_r = 0 (the feed-forward of
+// before) the swing decays with zeta 0.229 (0.854, 0.392, ... deg; the
+// issue's 0.3 missed), and with "feedforward": "none" and the gains of before
+// it (K5 = 30) the seed's law gives the numbers of before (0.1359 m, 0.0534 m
+// RMS; ch8_maneuvers --feedforward none).
 TEST(PathFeedforward, Ch8JTurnTracksWithItAndReproducesTheSeedsLawWithout) {
   Json g = {{"k1_rad_per_s2_per_m", 10}, {"k2_rad_per_s2", 2}, {"k3_rad_per_s2_per_m", 100}, {"k4_rad_per_s2", 80},
             {"k5_per_s", 10}, {"look_ahead_s", 0.5}, {"tracked_point_m", {0.0, 0.0, -0.64}}};
   const Ch8Run ff = runCh8JTurn(g, {}, 8.0);
+  const Ch8Run noYaw = runCh8JTurn(g, {{"plugins.path_control.yaw_rate_gain_per_s", 0.0}}, 8.0);
   g["k5_per_s"] = 30;
   const Ch8Run seed = runCh8JTurn(g, {{"plugins.path_control.feedforward", "none"}}, 8.0);
-  for (const auto& [name, r] : {std::pair{"linear_bicycle", &ff}, std::pair{"none", &seed}})
+  for (const auto& [name, r] : {std::pair{"linear_bicycle, K_r 40", &ff}, std::pair{"linear_bicycle, K_r 0", &noYaw},
+                                std::pair{"none", &seed}})
     std::printf("j1 2ws feedforward %s: max %.4f m, rms %.4f m; turn: %d half-swings, first %.3f deg, zeta %.3f, "
                 "%.2f Hz\n", name, r->max_error_m, r->rms_error_m, r->turn.half_swings,
                 r->turn.amplitudes.empty() ? 0.0 : r->turn.amplitudes[0] * 180 / SimTK::Pi, r->turn.zeta,
                 r->turn.frequency_hz);
-  EXPECT_LE(ff.max_error_m, 0.10);
-  EXPECT_LE(ff.rms_error_m, 0.03);
-  EXPECT_GE(ff.turn.half_swings, 3);
-  EXPECT_GE(ff.turn.zeta, 0.2);
+  EXPECT_NEAR(ff.max_error_m, 0.0627, 5e-4);
+  EXPECT_NEAR(ff.rms_error_m, 0.0221, 3e-4);
+  EXPECT_EQ(ff.turn.half_swings, 1);
+  ASSERT_FALSE(ff.turn.amplitudes.empty());
+  EXPECT_NEAR(ff.turn.amplitudes[0] * 180 / SimTK::Pi, 0.142, 0.005);
+  EXPECT_NEAR(noYaw.max_error_m, 0.0448, 5e-4);
+  EXPECT_NEAR(noYaw.turn.zeta, 0.229, 0.005);
   EXPECT_NEAR(seed.max_error_m, 0.1359, 5e-4);
   EXPECT_NEAR(seed.rms_error_m, 0.0534, 5e-4);
   EXPECT_NEAR(seed.turn.zeta, 0.183, 0.005);
+}
+
+// j1 with the linear strategy (Kr -0.205), the J-turn run whose swing was the
+// least damped (zeta 0.130 before): as shipped the swing decays with zeta
+// 0.322 (half-swings 0.130, 0.045 deg) and the run tracks within 0.0583 m
+// (0.0202 m RMS). A feed-forward naming a rear_control the scene does not have
+// before it is an error naming the key and the value.
+TEST(PathFeedforward, Ch8JTurnLinearStrategySwingDecaysAboveTheIssuesZeta) {
+  const Json g = {{"k1_rad_per_s2_per_m", 10}, {"k2_rad_per_s2", 2}, {"k3_rad_per_s2_per_m", 100},
+                  {"k4_rad_per_s2", 80}, {"k5_per_s", 10}, {"look_ahead_s", 0.5},
+                  {"tracked_point_m", {0.0, 0.0, -0.64}}};
+  const Ch8Run r = runCh8JTurn(g, {}, 8.0, "linear");
+  std::printf("j1 linear as shipped: max %.4f m, rms %.4f m; turn: %d half-swings, zeta %.3f, %.2f Hz\n",
+              r.max_error_m, r.rms_error_m, r.turn.half_swings, r.turn.zeta, r.turn.frequency_hz);
+  EXPECT_NEAR(r.max_error_m, 0.0583, 5e-4);
+  EXPECT_NEAR(r.rms_error_m, 0.0202, 3e-4);
+  EXPECT_EQ(r.turn.half_swings, 2);
+  EXPECT_NEAR(r.turn.zeta, 0.322, 0.01);
+  EXPECT_GE(r.turn.zeta, 0.3);
+  const std::string err =
+      test::errorOf([&] { runCh8JTurn(g, {{"plugins.path_control.feedforward_rear_control", "nope"}}, 0.1); });
+  EXPECT_NE(err.find("feedforward_rear_control"), std::string::npos) << err;
+  EXPECT_NE(err.find("'nope'"), std::string::npos) << err;
+}
+
+// The 4WS steady steer of feedforward_rear_control: delta_f (1 - Kr(U, delta_f))
+// = (l + K U^2) kappa for Kr constant (the linear strategy: delta_f is the
+// 2WS angle over 1 - Kr, j1: Kr -0.205 at 12 m/s, the 2WS angle 17 % high) and
+// Kr = C1 + C2 delta_f^2 (the nonlinear one, a cubic solved by iteration), and
+// calcSteadyCurvature inverts it.
+TEST(PathFeedforward, FourWsSteadySteerFollowsTheRearStrategysRatio) {
+  PathFeedforwardParams ff;
+  ff.type = "linear_bicycle";
+  ff.has_linear_bicycle = true;
+  const double U = 12, kappa = 1.0 / 30, ss2 = ff.calcSteadySteer(kappa, U, 0.0);
+  const std::function<double(double, double)> linear = [](double, double) { return -0.205; };
+  const double lin = ff.calcSteadySteer(kappa, U, 0.0, &linear);
+  EXPECT_NEAR(lin, ss2 / 1.205, 1e-15);
+  EXPECT_NEAR(ss2 / lin, 1.205, 1e-12);
+  EXPECT_NEAR(ff.calcSteadyCurvature(lin, U, 0.0, &linear), kappa, 1e-15);
+  const double c1 = -0.2301580826172259, c2 = 0.010843310928536826 * std::pow(180 / SimTK::Pi, 2);  // kr_table, 12 m/s
+  const std::function<double(double, double)> nonlinear = [&](double, double df) { return c1 + c2 * df * df; };
+  const double nl = ff.calcSteadySteer(kappa, U, 0.0, &nonlinear);
+  EXPECT_NEAR(nl * (1 - c1 - c2 * nl * nl), ss2, 1e-12);
+  EXPECT_NEAR(ff.calcSteadyCurvature(nl, U, 0.0, &nonlinear), kappa, 1e-12);
+  std::printf("j1 steady front angle: 2WS %.4f deg, linear 4WS %.4f deg, nonlinear 4WS %.4f deg (Kr %.4f)\n",
+              ss2 * 180 / SimTK::Pi, lin * 180 / SimTK::Pi, nl * 180 / SimTK::Pi, c1 + c2 * nl * nl);
+  ff.rear_steering = "rear_steer";
+  ff.rear_control = "rear_control";
+  EXPECT_EQ(test::errorOf([&] { ff.validate(); }),
+            "path control: feedforward_rear_steering \"rear_steer\" and feedforward_rear_control \"rear_control\" "
+            "both set; the rear angle is either measured or the strategy's, not both");
+  ff.rear_steering.clear();
+  ff.yaw_rate_gain_per_s = -1;
+  EXPECT_NE(test::errorOf([&] { ff.validate(); }).find("yaw_rate_gain_per_s"), std::string::npos);
 }
 
 // --- rear-steer strategies ---------------------------------------------------

@@ -51,7 +51,8 @@ struct RunResult {
 };
 
 /// The closed loop's damping in the turn of a J-turn: the log decrement
-/// (calcSwingDecay) of the front angle's half-swings above 1e-4 deg between
+/// (calcSwingDecay: from the largest half-swing while they decrease, pairs of
+/// extremes closer than 1e-4 deg dropped) of the front angle's half-swings between
 /// the circle's entry (the first sample whose chassis point refers to the arc)
 /// and 1 s before its exit (the look-ahead sees the exit earlier).
 SwingDecay calcTurnDamping(const Scenario& sc, const Recorder& rec) {
@@ -114,7 +115,8 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
       const SwingDecay d = calcTurnDamping(sc, rec);
       Json amps = Json::array();
       for (double a : d.amplitudes) amps.push_back(a * kDeg);
-      r.summary["turn_damping"] = {{"method", "log decrement of the front angle's half-swings in the turn"},
+      r.summary["turn_damping"] = {{"method", "log decrement of the front angle's half-swings in the turn, from the largest while they decrease, "
+                                               "sub-1e-4-deg pairs dropped (calcSwingDecay)"},
                                    {"half_swings", d.half_swings}, {"half_swings_deg", amps},
                                    {"zeta", d.half_swings >= 2 ? Json(d.zeta) : Json(nullptr)},
                                    {"frequency_hz", d.half_swings >= 2 ? Json(d.frequency_hz) : Json(nullptr)}};
@@ -273,6 +275,7 @@ int main(int argc, char** argv) {
       // gains (gains_feedforward_none: the J-turns' K5 = 30 of before the
       // feed-forward, so that --feedforward none reproduces those runs). Both read.
       const char* gainsKey = "gains";
+      PathControlParams::fromParams(r.child("gains"));  // read (and checked) whichever is used
       if (r.has("gains_feedforward_none")) {
         PathControlParams::fromParams(r.child("gains_feedforward_none"));
         if (feedforward == "none") gainsKey = "gains_feedforward_none";
@@ -397,7 +400,13 @@ int main(int argc, char** argv) {
         const Json& d = j["turn_damping"];
         char buf[64];
         if (d["zeta"].is_null()) {
-          damping = "no half-swing pair above 1e-4 deg";
+          const Json& a = d["half_swings_deg"];
+          if (a.empty()) {
+            damping = "no half-swing above 1e-4 deg";
+          } else {
+            std::snprintf(buf, sizeof buf, "no swing to decay (one half-swing, %.3g deg)", a[0].get<double>());
+            damping = buf;
+          }
         } else {
           std::snprintf(buf, sizeof buf, "%.3f (", d["zeta"].get<double>());
           damping = buf;

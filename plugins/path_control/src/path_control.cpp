@@ -1,7 +1,9 @@
 #include "vdyn/path_control/path_control.h"
 
 #include "vdyn/core/fields.h"
+#include "vdyn/rear_steer/rear_steer.h"
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 
@@ -29,6 +31,12 @@ void PathFeedforwardParams::validate() const {
     throw Error("path control feedforward must be \"none\" or \"linear_bicycle\", got \"" + type + "\"");
   requireNonNegative(preview_s, "path control feedforward_preview_s");
   requirePositive(lag_s, "path control feedforward_lag_s");
+  requireNonNegative(yaw_rate_gain_per_s, "path control yaw_rate_gain_per_s");
+  requirePositive(yaw_inertia_kg_m2, "path control yaw_inertia_kg_m2");
+  if (!rear_steering.empty() && !rear_control.empty())
+    throw Error("path control: feedforward_rear_steering \"" + rear_steering + "\" and feedforward_rear_control \"" +
+                rear_control + "\" both set; the rear angle is either measured or the strategy's, not both");
+
   if (type == "linear_bicycle") {
     if (!has_linear_bicycle)
       throw Error("path control feedforward \"linear_bicycle\" needs the key linear_bicycle {mass_kg, ...}");
@@ -40,9 +48,31 @@ void PathFeedforwardParams::validate() const {
 // r = U kappa): delta_f - delta_r = (l + K U^2) kappa, the same relation as
 // calcLinearSteadyYawRate's r = U delta_f (1 - Kr) / (l + K U^2) with
 // delta_r = Kr delta_f.
-double PathFeedforwardParams::calcSteadySteer(double kappa, double U, double rear) const {
+double PathFeedforwardParams::calcSteadySteer(double kappa, double U, double rear,
+                                             const std::function<double(double, double)>* ratio) const {
   if (type == "none") return 0;
-  return rear + (linear_bicycle.wheelbase_m() + linear_bicycle.understeerGradient() * U * U) * kappa;
+  const double bicycle = (linear_bicycle.wheelbase_m() + linear_bicycle.understeerGradient() * U * U) * kappa;
+  if (!ratio || !*ratio) return rear + bicycle;
+  // The 4WS steady turn with delta_r = Kr(U, delta_f) delta_f (8.1)-(8.4):
+  // delta_f (1 - Kr(U, delta_f)) = (l + K U^2) kappa, by fixed-point iteration
+  // from the 2WS angle (Kr constant: one step; Kr = C1 + C2 delta_f^2: the map's
+  // slope is 2 C2 delta_f^2 / (1 - Kr), 0.1-0.3 on the chapter 8 turns).
+  double df = bicycle;
+  for (int it = 0; it < 50; ++it) {
+    const double next = bicycle / (1 - (*ratio)(U, df));
+    if (!std::isfinite(next)) return bicycle;  // Kr -> 1: no steady 4WS turn; the 2WS angle
+    const bool done = std::abs(next - df) <= 1e-12;
+    df = next;
+    if (done) break;
+  }
+  return df;
+}
+
+double PathFeedforwardParams::calcSteadyCurvature(double df, double U, double rear,
+                                                  const std::function<double(double, double)>* ratio) const {
+  if (type == "none") return 0;
+  const double dr = ratio && *ratio ? (*ratio)(U, df) * df : rear;
+  return (df - dr) / (linear_bicycle.wheelbase_m() + linear_bicycle.understeerGradient() * U * U);
 }
 
 const FieldTable<PathFeedforwardParams>& PathFeedforwardParams::fields() {
@@ -65,16 +95,23 @@ const FieldTable<PathFeedforwardParams>& PathFeedforwardParams::fields() {
           .number("feedforward_preview_s", &P::preview_s, "s",
                   "T_ff: the curvature is read at the path point of p + v T_ff")
           .number("feedforward_lag_s", &P::lag_s, "s", "tau_ff of each of the two first-order stages filtering delta_ss")
+          .string("feedforward_rear_control", &P::rear_control,
+                  "rear_steer plugin (listed before this one) whose Kr(U, delta_f) gives the 4WS steady steer "
+                  "delta_f (1 - Kr) = (l + K U^2) kappa; \"\" for the 2WS one")
+          .number("yaw_rate_gain_per_s", &P::yaw_rate_gain_per_s, "1/s",
+                  "K_r: delta'' -= K_r (r - r_ref), r_ref the yaw rate of the linear bicycle steered by the filtered "
+                  "feed-forward f (with a feedforward only: none is the seed's law)")
+          .number("yaw_inertia_kg_m2", &P::yaw_inertia_kg_m2, "kg m^2", "I_z of the reference bicycle of K_r")
           .string("feedforward_rear_steering", &P::rear_steering,
                   "steering plugin whose angle is delta_r (4WS rear); \"\": none (2WS)");
   return t;
 }
 
 double calcFeedforwardTarget(const PathFeedforwardParams& ff, const ReferencePath& path, const Vec2& p_G,
-                             const Vec2& v_G, double rear_rad) {
+                             const Vec2& v_G, double rear_rad, const std::function<double(double, double)>* ratio) {
   if (!ff.enabled()) return 0;
   const PathPoint ahead = path.calcReferencePoint(p_G + v_G * ff.preview_s);
-  return ff.calcSteadySteer(ahead.curvature_per_m, v_G.norm(), rear_rad);
+  return ff.calcSteadySteer(ahead.curvature_per_m, v_G.norm(), rear_rad, ratio);
 }
 
 namespace {
@@ -106,9 +143,11 @@ PathController::PathController(std::string name, const PathControlParams& params
                                std::shared_ptr<const ReferencePath> path, const SimTK::MobilizedBody& chassis,
                                const SteeringActuator& steer, SimTK::Measure ax, SimTK::Measure ay,
                                const PathFeedforwardParams& feedforward, const SteeringActuator* rear,
-                               SimTK::Measure stage1, SimTK::Measure filtered)
+                               SimTK::Measure stage1, SimTK::Measure filtered,
+                               std::function<double(double, double)> rearRatio, SimTK::Measure referenceYawRate)
     : SteeringLaw(std::move(name)), p_(params), path_(std::move(path)), chassis_(chassis), steer_(&steer), ax_(ax),
-      ay_(ay), ff_(feedforward), rear_(rear), stage1_(stage1), filtered_(filtered) {
+      ay_(ay), ff_(feedforward), rear_(rear), stage1_(stage1), filtered_(filtered), ratio_(std::move(rearRatio)),
+      yawRef_(referenceYawRate) {
   p_.validate();
   ff_.validate();
   assert(!ff_.enabled() || !filtered_.isEmptyHandle());
@@ -133,8 +172,8 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
     const double U = e.v_G.norm();
     e.feedforward_rad = filtered_.getValue(s);
     if (U > 0) {
-      const double gain = ff_.calcSteadySteer(1.0, U, 0.0);  // l + K U^2, rad per 1/m
-      const double kG = (stage1_.getValue(s) - rear) / gain, kF = (e.feedforward_rad - rear) / gain;
+      const double kG = ff_.calcSteadyCurvature(stage1_.getValue(s), U, rear, &ratio_),
+                   kF = ff_.calcSteadyCurvature(e.feedforward_rad, U, rear, &ratio_);
       e.a_G += U * U * (kG - kF) * Vec2(-e.v_G[1], e.v_G[0]) / U;
     }
   }
@@ -150,9 +189,15 @@ PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) cons
                    p_.k5_per_s * e.steer_rate_rad_s;
   if (ff_.enabled()) {
     // The feed-forward through the damper: -K5 (delta' - f') (header, docs/path_feedforward.md).
-    e.feedforward_target_rad = calcFeedforwardTarget(ff_, *path_, e.p_G, e.v_G, rear);
+    e.feedforward_target_rad = calcFeedforwardTarget(ff_, *path_, e.p_G, e.v_G, rear, &ratio_);
     e.feedforward_rate_rad_s = (stage1_.getValue(s) - e.feedforward_rad) / ff_.lag_s;
     e.accel_rad_s2 += p_.k5_per_s * e.feedforward_rate_rad_s;
+    if (!yawRef_.isEmptyHandle()) {
+      // Yaw-rate feedback about the reference bicycle (header, docs/path_feedforward.md).
+      e.reference_yaw_rate_rad_s = yawRef_.getValue(s);
+      e.yaw_rate_error_rad_s = chassis_.getBodyAngularVelocity(s)[2] - e.reference_yaw_rate_rad_s;
+      e.accel_rad_s2 -= ff_.yaw_rate_gain_per_s * e.yaw_rate_error_rad_s;
+    }
   }
   return e;
 }
@@ -196,6 +241,59 @@ class FirstOrderLagMeasure : public SimTK::Measure_<SimTK::Real> {
   };
   FirstOrderLagMeasure(SimTK::Subsystem& sub, Input input, double tau)
       : SimTK::Measure_<SimTK::Real>(sub, new Implementation(std::move(input), tau),
+                                     SimTK::AbstractMeasure::SetHandle()) {}
+};
+
+/// The reference model of the yaw-rate feedback: the linear bicycle ((6.5)-(6.6),
+/// chapter 6) at the speed U(s), steered by delta_f(s) and delta_r(s), two z
+/// variables (v, r) with
+///     M (v' + U r) = F_f + F_r,   I_z r' = a F_f - b F_r,
+///     F_f = C_af (delta_f - (v + a r) / U),   F_r = C_ar (delta_r - (v - b r) / U);
+/// its value is r. Set like FirstOrderLagMeasure's (Stage::Acceleration).
+class ReferenceBicycleMeasure : public SimTK::Measure_<SimTK::Real> {
+ public:
+  /// Speed U, front and rear angles of a state.
+  using Inputs = std::function<void(const SimTK::State&, double& U, double& df, double& dr)>;
+  class Implementation : public SimTK::Measure_<SimTK::Real>::Implementation {
+   public:
+    Implementation(Inputs in, LinearBicycleParams p, double iz)
+        : SimTK::Measure_<SimTK::Real>::Implementation(0.0, 0), in_(std::move(in)), p_(p), iz_(iz) {}
+    Implementation* cloneVirtual() const override { return new Implementation(*this); }
+    int getNumTimeDerivativesVirtual() const override { return 0; }
+    SimTK::Stage getDependsOnStageVirtual(int) const override { return SimTK::Stage::Time; }
+    const SimTK::Real& getUncachedValueVirtual(const SimTK::State& s, int) const override {
+      return getSubsystem().getZ(s)[zIndex_ + 1];
+    }
+    void realizeMeasureTopologyVirtual(SimTK::State& s) const override {
+      zIndex_ = getSubsystem().allocateZ(s, SimTK::Vector(2, 0.0));
+    }
+    void initializeVirtual(SimTK::State& s) const override {
+      getSubsystem().updZ(s)[zIndex_] = getSubsystem().updZ(s)[zIndex_ + 1] = 0;
+    }
+    void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
+      double U = 0, df = 0, dr = 0;
+      in_(s, U, df, dr);
+      const double v = getSubsystem().getZ(s)[zIndex_], r = getSubsystem().getZ(s)[zIndex_ + 1];
+      double vd = 0, rd = 0;
+      if (U > 0.1) {
+        const double a = p_.front_axle_to_com_m, b = p_.rear_axle_to_com_m;
+        const double Ff = p_.front_cornering_stiffness_N_per_rad * (df - (v + a * r) / U),
+                     Fr = p_.rear_cornering_stiffness_N_per_rad * (dr - (v - b * r) / U);
+        vd = (Ff + Fr) / p_.mass_kg - U * r;
+        rd = (a * Ff - b * Fr) / iz_;
+      }
+      getSubsystem().updZDot(s)[zIndex_] = vd;
+      getSubsystem().updZDot(s)[zIndex_ + 1] = rd;
+    }
+
+   private:
+    Inputs in_;
+    LinearBicycleParams p_;
+    double iz_;
+    mutable SimTK::ZIndex zIndex_;
+  };
+  ReferenceBicycleMeasure(SimTK::Subsystem& sub, Inputs in, const LinearBicycleParams& p, double iz)
+      : SimTK::Measure_<SimTK::Real>(sub, new Implementation(std::move(in), p, iz),
                                      SimTK::AbstractMeasure::SetHandle()) {}
 };
 
@@ -249,12 +347,22 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   }
   const SteeringActuator* rear = nullptr;
   SimTK::Measure stage1, filtered;
+  std::function<double(double, double)> ratio;
+  SimTK::Measure yawRef;
   if (ff_.enabled()) {
     if (!ff_.rear_steering.empty()) {
       rear = scene.findPlugin<SteeringActuator>(ff_.rear_steering);
       if (!rear)
         throw Error("path control plugin '" + name() + "': feedforward_rear_steering: the scene has no steering plugin '" +
                     ff_.rear_steering + "'");
+    }
+    if (!ff_.rear_control.empty()) {
+      const auto* rc = scene.findPlugin<RearSteerPlugin>(ff_.rear_control);
+      if (!rc)
+        throw Error("path control plugin '" + name() + "': feedforward_rear_control: no rear_steer plugin '" +
+                    ff_.rear_control + "' before it in the scene (list it before '" + name() + "')");
+      const std::shared_ptr<const RearSteerStrategy> st = rc->strategyHandle();
+      ratio = [st](double U, double df) { return st->calcTarget(U, df, 0, 0).kr; };
     }
     // Two first-order stages g, f (a critically damped second-order filter):
     // f' = (g - f) / tau_ff is continuous where delta_ss steps.
@@ -265,16 +373,32 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
     const PathFeedforwardParams ff = ff_;
     stage1 = FirstOrderLagMeasure(
         scene.updForces(),
-        [matter, body, station, path, ff, rear](const SimTK::State& s) {  // delta_ss (needs Stage::Velocity)
+        [matter, body, station, path, ff, rear, ratio](const SimTK::State& s) {  // delta_ss (needs Stage::Velocity)
           const SimTK::MobilizedBody& b = matter->getMobilizedBody(body);
           const Vec3 p = b.findStationLocationInGround(s, station), v = b.findStationVelocityInGround(s, station);
-          return calcFeedforwardTarget(ff, *path, Vec2(p[0], p[1]), Vec2(v[0], v[1]), rear ? rear->getAngle(s) : 0.0);
+          return calcFeedforwardTarget(ff, *path, Vec2(p[0], p[1]), Vec2(v[0], v[1]), rear ? rear->getAngle(s) : 0.0,
+                                       &ratio);
         },
         ff_.lag_s);
     filtered = FirstOrderLagMeasure(
         scene.updForces(), [stage1](const SimTK::State& s) { return stage1.getValue(s); }, ff_.lag_s);
+    if (ff_.yaw_rate_gain_per_s > 0) {
+      // The reference bicycle steered by f and its rear angle (Kr(U, f) f, the
+      // measured delta_r, or 0), at the tracked point's speed.
+      const SimTK::Measure f = filtered;
+      yawRef = ReferenceBicycleMeasure(
+          scene.updForces(),
+          [matter, body, station, f, rear, ratio](const SimTK::State& s, double& U, double& df, double& dr) {
+            const Vec3 v = matter->getMobilizedBody(body).findStationVelocityInGround(s, station);
+            U = std::sqrt(v[0] * v[0] + v[1] * v[1]);
+            df = f.getValue(s);
+            dr = ratio ? ratio(U, df) * df : rear ? rear->getAngle(s) : 0.0;
+          },
+          ff_.linear_bicycle, ff_.yaw_inertia_kg_m2);
+    }
   }
-  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, *steer, ax, ay, ff_, rear, stage1, filtered);
+  law_ = std::make_shared<PathController>(name(), p_, path_, chassis, *steer, ax, ay, ff_, rear, stage1, filtered,
+                                          ratio, yawRef);
   steer->setAccelerationLaw(law_);
   const auto law = law_;
   auto add = [&](const std::string& key, const std::string& unit, auto f) {
@@ -287,6 +411,7 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
   add("feedforward_rad", "rad", [](const PathControlEvaluation& e) { return e.feedforward_rad; });
   add("feedforward_target_rad", "rad", [](const PathControlEvaluation& e) { return e.feedforward_target_rad; });
+  add("reference_yaw_rate_rad_s", "rad/s", [](const PathControlEvaluation& e) { return e.reference_yaw_rate_rad_s; });
   // The estimated acceleration's component normal to the velocity (+ left).
   add("lateral_acceleration_m_s2", "m/s^2", [](const PathControlEvaluation& e) {
     const double v = e.v_G.norm();
@@ -335,19 +460,43 @@ SwingDecay calcSwingDecay(const std::vector<double>& t, const std::vector<double
   std::vector<double> ext, tExt;
   for (std::size_t i = 1; i + 1 < x.size(); ++i)
     if (t[i] >= t0 && t[i] <= t1 && (x[i] - x[i - 1]) * (x[i + 1] - x[i]) < 0) ext.push_back(x[i]), tExt.push_back(t[i]);
+  // 1. A pair of extremes closer than the floor is an inflection's wiggle or
+  //    noise, not a swing: drop both and merge what is left into alternating
+  //    extremes (a run of maxima keeps its largest, of minima its smallest).
+  for (bool changed = true; changed;) {
+    changed = false;
+    for (std::size_t k = 0; k + 1 < ext.size(); ++k)
+      if (std::abs(ext[k + 1] - ext[k]) <= floor) {
+        ext.erase(ext.begin() + k, ext.begin() + k + 2), tExt.erase(tExt.begin() + k, tExt.begin() + k + 2);
+        changed = true;
+        break;
+      }
+    for (std::size_t k = 1; k + 1 < ext.size(); ++k)
+      if ((ext[k] - ext[k - 1]) * (ext[k + 1] - ext[k]) > 0) {  // k is no extreme any more
+        ext.erase(ext.begin() + k), tExt.erase(tExt.begin() + k);
+        changed = true;
+        break;
+      }
+  }
+  std::vector<double> a;
+  for (std::size_t k = 0; k + 1 < ext.size(); ++k) a.push_back(std::abs(ext[k + 1] - ext[k]));
+  // 2. The free decay starts at the largest half-swing (those before it are
+  //    still forced: the turn's entry), and 3. ends before a half-swing that
+  //    grows (a second, slower motion, or the exit's look-ahead).
   SwingDecay d;
-  if (!tExt.empty()) d.first_extreme_time_s = tExt.front();
-  for (std::size_t k = 0; k + 1 < ext.size(); ++k) {
-    const double a = std::abs(ext[k + 1] - ext[k]);
-    if (a <= floor) break;
-    d.amplitudes.push_back(a);
+  if (a.empty()) return d;
+  const std::size_t k0 = std::size_t(std::max_element(a.begin(), a.end()) - a.begin());
+  d.first_extreme_time_s = tExt[k0];
+  for (std::size_t k = k0; k < a.size(); ++k) {
+    if (k > k0 && a[k] > a[k - 1]) break;
+    d.amplitudes.push_back(a[k]);
   }
   d.half_swings = int(d.amplitudes.size());
   if (d.half_swings < 2) return d;
   const int n = d.half_swings;
   const double dec = 2 * std::log(d.amplitudes.front() / d.amplitudes.back()) / (n - 1);
   d.zeta = dec / std::sqrt(4 * SimTK::Pi * SimTK::Pi + dec * dec);
-  d.frequency_hz = 1 / (2 * (tExt[n] - tExt[0]) / n);
+  d.frequency_hz = 1 / (2 * (tExt[k0 + n] - tExt[k0]) / n);
   return d;
 }
 

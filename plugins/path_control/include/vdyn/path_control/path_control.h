@@ -45,7 +45,15 @@
 // Without it the look-ahead errors e3, e4 see the coming circle as well and
 // the feedback turns in on top of the feed-forward (j1: 0.16 m off the path,
 // worse than the seed's law); in a steady turn g = f and x'' is the seed's.
-// "none" is the seed's law unchanged.
+// With a rear_steer plugin named (feedforward_rear_control), delta_ss is the
+// 4WS steady front angle of its strategy, delta_f (1 - Kr(U, delta_f)) =
+// (l + K U^2) kappa, Kr evaluated open-loop. The yaw-rate feedback
+// (yaw_rate_gain_per_s K_r > 0) adds -K_r (r - r_ref) to delta'', r_ref the
+// yaw rate of the linear bicycle (two z variables; I_z yaw_inertia_kg_m2)
+// steered by f and Kr f: zero on the nominal motion and in a steady turn, it
+// damps the loop's 1.2-1.6 Hz steer-yaw swing of the chapter 8 J-turns.
+// "none" is the seed's law unchanged (both keys ignored).
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -102,12 +110,30 @@ struct PathFeedforwardParams {
   double lag_s = 0.1;
   /// Steering plugin whose angle is delta_r (a 4WS rear axle); "" for none (2WS).
   std::string rear_steering;
+  /// A rear_steer plugin (added to the scene before this one) whose strategy's
+  /// ratio Kr(U, delta_f) enters the steady steer open-loop, the 4WS gain:
+  /// delta_f (1 - Kr(U, delta_f)) = (l + K U^2) kappa; "" for none (2WS gain).
+  std::string rear_control;
+  /// K_r, yaw-rate feedback about a reference model: delta'' -= K_r (r - r_ref),
+  /// r the chassis yaw rate, r_ref the yaw rate of the linear bicycle (with
+  /// yaw_inertia_kg_m2) steered by f (front) and Kr(U, f) f or delta_r (rear), 1/s (>= 0).
+  double yaw_rate_gain_per_s = 0;
+  /// I_z of the reference model's linear bicycle, kg m^2 (> 0).
+  double yaw_inertia_kg_m2 = 1300;
 
   bool enabled() const { return type != "none"; }
   void validate() const;
   /// delta_ss = delta_r + (l + K U^2) kappa, rad (+ left), for a path
   /// curvature kappa (1/m, + left), speed U (m/s) and rear angle delta_r (rad).
-  double calcSteadySteer(double curvature_per_m, double speed_m_s, double rear_rad) const;
+  /// With `ratio` (feedforward_rear_control: the rear strategy's Kr(U, delta_f))
+  /// the front angle of the 4WS steady turn, delta_f (1 - Kr) = (l + K U^2) kappa
+  /// (rear_rad is then 0).
+  double calcSteadySteer(double curvature_per_m, double speed_m_s, double rear_rad,
+                         const std::function<double(double, double)>* ratio = nullptr) const;
+  /// The inverse: the curvature a steady turn with front angle delta_f (rad) has,
+  /// (delta_f - delta_r) / (l + K U^2), delta_r = rear_rad or Kr(U, delta_f) delta_f.
+  double calcSteadyCurvature(double front_rad, double speed_m_s, double rear_rad,
+                             const std::function<double(double, double)>* ratio = nullptr) const;
   /// The keys (one table: read by the plugin entry, documented by `vdyn list`).
   static const FieldTable<PathFeedforwardParams>& fields();
 };
@@ -120,7 +146,9 @@ struct PathControlEvaluation {
   double steer_rate_rad_s = 0;          ///< delta'
   double feedforward_target_rad = 0;    ///< delta_ss at the previewed point (0 with no feed-forward)
   double feedforward_rad = 0;           ///< f, the filtered feed-forward steer
-  double feedforward_rate_rad_s = 0;    ///< f' = (delta_ss - f) / tau_ff
+  double feedforward_rate_rad_s = 0;    ///< f' = (g - f) / tau_ff
+  double reference_yaw_rate_rad_s = 0;  ///< r_ref of the reference bicycle (0 with no feed-forward)
+  double yaw_rate_error_rad_s = 0;      ///< r - r_ref (0 with no feed-forward)
   double accel_rad_s2 = 0;              ///< delta'' (7.17)-(7.18), plus K5 f' with the feed-forward
 };
 
@@ -136,7 +164,8 @@ class PathController : public SteeringLaw {
                  const SimTK::MobilizedBody& chassis, const SteeringActuator& steer,
                  SimTK::Measure ax_lagged, SimTK::Measure ay_lagged,
                  const PathFeedforwardParams& feedforward = {}, const SteeringActuator* rear = nullptr,
-                 SimTK::Measure stage1 = {}, SimTK::Measure filtered = {});
+                 SimTK::Measure stage1 = {}, SimTK::Measure filtered = {},
+                 std::function<double(double, double)> rearRatio = {}, SimTK::Measure referenceYawRate = {});
   PathControlEvaluation calcEvaluation(const SimTK::State& s) const;
   const PathControlParams& params() const { return p_; }
   const PathFeedforwardParams& feedforward() const { return ff_; }
@@ -155,12 +184,15 @@ class PathController : public SteeringLaw {
   PathFeedforwardParams ff_;
   const SteeringActuator* rear_ = nullptr;  // owned by the same scene
   SimTK::Measure stage1_, filtered_;
+  std::function<double(double, double)> ratio_;  // Kr(U, delta_f) of feedforward_rear_control, or empty
+  SimTK::Measure yawRef_;                         // r_ref, empty with no yaw-rate feedback
 };
 
 /// delta_ss of the feed-forward for a tracked point at p_G moving with v_G:
 /// the path's curvature at the reference point of p_G + v_G T_ff, at U = |v_G|.
 double calcFeedforwardTarget(const PathFeedforwardParams& ff, const ReferencePath& path, const SimTK::Vec2& p_G,
-                             const SimTK::Vec2& v_G, double rear_rad);
+                             const SimTK::Vec2& v_G, double rear_rad,
+                             const std::function<double(double, double)>* ratio = nullptr);
 
 /// Controller plugin: sets a PathController as the law of the named
 /// state-driven steering (any SteeringActuator). Outputs <name>.e1_m, .e2, .e3_m, .e4,
@@ -189,15 +221,17 @@ class PathControlPlugin : public ControllerPlugin {
 };
 
 /// The damping of a decaying swing by the logarithmic decrement: the extremes
-/// of x(t) for t in [t0_s, t1_s], the half-swings A_k = |x_{k+1} - x_k|
-/// between successive extremes (a constant offset drops out) while they stay
-/// above floor, d = 2 ln(A_1 / A_n) / (n - 1) per period and
+/// of x(t) for t in [t0_s, t1_s]; a pair of extremes closer than `floor` is a
+/// wiggle (an inflection, noise) and dropped; the half-swings A_k = |x_{k+1} -
+/// x_k| between the remaining extremes (a constant offset drops out) from the
+/// largest (the free decay; those before are forced) while they decrease (a
+/// growing one is a second motion); d = 2 ln(A_1 / A_n) / (n - 1) per period,
 /// zeta = d / sqrt(4 pi^2 + d^2), the frequency from the mean spacing of the
-/// extremes. `half_swings` < 2: no decrement (no swing above the floor).
+/// extremes. `half_swings` < 2: no decrement (no decaying swing in the window).
 struct SwingDecay {
   int half_swings = 0;                     ///< n, half-swings above the floor
   std::vector<double> amplitudes;          ///< A_1 .. A_n (x's unit)
-  double first_extreme_time_s = 0;         ///< time of the first extreme
+  double first_extreme_time_s = 0;         ///< time of the extreme A_1 starts at
   double zeta = 0, frequency_hz = 0;       ///< 0 when half_swings < 2
 };
 SwingDecay calcSwingDecay(const std::vector<double>& t_s, const std::vector<double>& x, double t0_s, double t1_s,

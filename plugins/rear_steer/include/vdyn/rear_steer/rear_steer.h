@@ -155,6 +155,8 @@ class RearSteerPlugin : public ControllerPlugin {
   /// Names of the rear steering plugin it drives and the front one it reads.
   const std::string& rearSteering() const { return rear_; }
   const std::string& frontSteering() const { return front_; }
+  /// The strategy (shared: a path controller's 4WS feed-forward reads its Kr).
+  const std::shared_ptr<const RearSteerStrategy>& strategyHandle() const { return strategy_; }
 
  protected:
   void DoAddTo(Scene& scene) override;
