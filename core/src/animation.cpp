@@ -354,7 +354,13 @@ function main(THREE) {
   const sun = new THREE.DirectionalLight(0xffffff, 1.5);
   sun.position.set(-5, 10, 7);
   scene.add(sun);
-  const grid = new THREE.GridHelper(200, 200, 0x777777, 0xaaaaaa);
+  // The ground: a plane and a 1 m grid on it (moved with the vehicle, in 10 m steps).
+  const grid = new THREE.Group();
+  const plane = new THREE.Mesh(new THREE.PlaneGeometry(400, 400), new THREE.MeshBasicMaterial({color: 0xdfe3e8}));
+  plane.rotation.x = -Math.PI / 2;
+  plane.position.y = -0.005;
+  grid.add(plane);
+  grid.add(new THREE.GridHelper(200, 200, 0x8a8f96, 0xb4b9c0));
   scene.add(grid);
 
   const tracks = [];
