@@ -73,14 +73,16 @@ AnimationShape shapeOf(const std::string& name, const SimTK::MassProperties& mp,
   if (name == "chassis") {
     // The chassis's box clear of the wheels: no wider than its innermost
     // joint off the centre plane (|y| > 0.1 m, the suspension's inboard
-    // points), its bottom no lower than their mean height.
+    // points), its bottom no lower than the mean height of its joints more
+    // than 0.3 m from the mass centre horizontally (suspension points, a
+    // single-track model's axles).
     double halfWidth = shape.size_m[1] / 2, zSum = 0;
     int n = 0;
-    for (const auto& p : points_B)
-      if (std::abs(p[1] - shape.centre_B[1]) > 0.1) {
-        halfWidth = std::min(halfWidth, std::abs(p[1] - shape.centre_B[1]));
-        zSum += p[2], ++n;
-      }
+    for (const auto& p : points_B) {
+      const SimTK::Vec3 d = p - shape.centre_B;
+      if (std::abs(d[1]) > 0.1) halfWidth = std::min(halfWidth, std::abs(d[1]));
+      if (std::hypot(d[0], d[1]) > 0.3) zSum += p[2], ++n;
+    }
     const double top = shape.centre_B[2] + shape.size_m[2] / 2;
     const double bottom = std::max(shape.centre_B[2] - shape.size_m[2] / 2, n ? zSum / n : -INFINITY);
     shape.size_m[1] = 2 * halfWidth;
@@ -354,13 +356,20 @@ function main(THREE) {
   const sun = new THREE.DirectionalLight(0xffffff, 1.5);
   sun.position.set(-5, 10, 7);
   scene.add(sun);
-  // The ground: a plane and a 1 m grid on it (moved with the vehicle, in 10 m steps).
+  // The ground: a plane and an 80 m grid of 1 m on it (moved with the vehicle, in 10 m steps).
   const grid = new THREE.Group();
   const plane = new THREE.Mesh(new THREE.PlaneGeometry(400, 400), new THREE.MeshBasicMaterial({color: 0xdfe3e8}));
   plane.rotation.x = -Math.PI / 2;
   plane.position.y = -0.005;
   grid.add(plane);
-  grid.add(new THREE.GridHelper(200, 200, 0x8a8f96, 0xb4b9c0));
+  // In 1 m segments: a long line that passes behind the camera is lost by
+  // some GL implementations' clipping (SwiftShader's).
+  const lines = [];
+  for (let i = -40; i <= 40; ++i)
+    for (let j = -40; j < 40; ++j) lines.push(i, 0, j, i, 0, j + 1, j, 0, i, j + 1, 0, i);
+  const gridGeometry = new THREE.BufferGeometry();
+  gridGeometry.setAttribute("position", new THREE.Float32BufferAttribute(lines, 3));
+  grid.add(new THREE.LineSegments(gridGeometry, new THREE.LineBasicMaterial({color: 0xa8adb4})));
   scene.add(grid);
 
   const tracks = [];
