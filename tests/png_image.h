@@ -1,6 +1,7 @@
 #pragma once
 // A minimal PNG reader for the plot tests (what pngcairo writes: 8-bit RGB or
-// RGBA, not interlaced; zlib and the five row filters) and counts of drawn
+// RGBA, not interlaced, as Chromium's screenshots too; zlib and the five row
+// filters) and counts of drawn
 // pixels per panel of a gnuplot multiplot grid.
 #include <zlib.h>
 
@@ -18,6 +19,8 @@ namespace vdyn::test {
 struct Image {
   int width = 0, height = 0;
   std::vector<unsigned char> rgb;  ///< width x height x 3
+  /// The pixel (x, y): its red, green, blue.
+  const unsigned char* at(int x, int y) const { return &rgb[3 * (std::size_t(y) * width + x)]; }
   bool isLineColour(int x, int y) const {
     // gnuplot's first line colour, dark violet (148, 0, 211), and its
     // anti-aliased edge: red and blue well above green.
@@ -46,6 +49,9 @@ struct Image {
     return n;
   }
 };
+
+/// Chromium's screenshots are read the same way (test_animation).
+using PngImage = Image;
 
 inline std::uint32_t be32(const unsigned char* p) { return (std::uint32_t(p[0]) << 24) | (p[1] << 16) | (p[2] << 8) | p[3]; }
 

@@ -11,6 +11,8 @@ Recorder::Recorder(const Scene& scene, std::vector<std::string> names)
     outputs_.push_back(&scene_.getOutput(n));
     if (outputs_.back()->stage > stage_) stage_ = outputs_.back()->stage;
   }
+  observer_ = scene_.getSampleObserver();
+  if (observer_ && stage_ < SimTK::Stage::Position) stage_ = SimTK::Stage::Position;  // it reads X_GB
   columns_.resize(names_.size());
 }
 
@@ -39,6 +41,7 @@ void Recorder::record(const SimTK::State& state) {
   }
   time_.push_back(s->getTime());
   for (std::size_t i = 0; i < outputs_.size(); ++i) columns_[i].push_back(outputs_[i]->eval(*s));
+  if (observer_) observer_(*s);
 }
 
 void Recorder::recordInterpolated(double t, double t0, const SimTK::Vector& y0, const SimTK::Vector& f0,
@@ -63,6 +66,7 @@ void Recorder::recordInterpolated(double t, double t0, const SimTK::Vector& y0, 
   if (stage_ > SimTK::Stage::Position) system.realize(work_, stage_);
   time_.push_back(t);
   for (std::size_t i = 0; i < outputs_.size(); ++i) columns_[i].push_back(outputs_[i]->eval(work_));
+  if (observer_) observer_(work_);
 }
 
 const std::vector<double>& Recorder::column(const std::string& name) const {

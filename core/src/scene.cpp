@@ -303,6 +303,12 @@ static std::string joinKeys(const std::vector<std::string>& names) {
   return s.empty() ? "(none)" : s;
 }
 
+std::vector<std::string> Scene::getBodyNames() const {
+  std::vector<std::string> names;
+  for (const auto& kv : bodies_) names.push_back(kv.first);
+  return names;
+}
+
 const SimTK::MobilizedBody& Scene::getBody(const std::string& name) const {
   auto it = bodies_.find(name);
   if (it == bodies_.end()) {

@@ -1,4 +1,5 @@
 #include "vdyn/core/scene_file.h"
+#include "vdyn/core/animation.h"
 #include "vdyn/core/plot.h"
 
 #include <algorithm>
@@ -433,9 +434,26 @@ SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& opt
     if (ec) throw Error("cannot create output folder '" + options.out_dir + "': " + ec.message());
   }
   const AnalysisContext ctx{scene, built, options.out_dir, options.progress};
+  std::unique_ptr<AnimationRecorder> animation;
+  if (options.animation) {
+    if (options.out_dir.empty()) throw Error("--animation: no output folder to write animation.glb into");
+    animation = std::make_unique<AnimationRecorder>(built.scene());
+    AnimationRecorder* rec = animation.get();
+    built.scene().setSampleObserver([rec](const SimTK::State& s) { rec->sample(s); });
+  }
   AnalysisResult r = built.analysis->run(ctx);
   Json summary = {{"scene", scene.name()}, {"analysis", built.analysis->type()}};
   for (auto it = r.summary.begin(); it != r.summary.end(); ++it) summary[it.key()] = it.value();
+  if (animation) {
+    if (animation->size() < 2)
+      throw Error("--animation: scene '" + scene.name() + "': analysis '" + built.analysis->type() +
+                  "' sampled no time history of its scene (" + std::to_string(animation->size()) +
+                  " samples; an animation needs a transient analysis with report_interval_s > 0)");
+    Json files = Json::array();
+    for (const auto& f : writeAnimation(*animation, options.out_dir + "/animation", scene.name()))
+      files.push_back(std::filesystem::path(f).filename().string());
+    summary["animation"] = files;
+  }
   if (!options.out_dir.empty()) {
     for (const auto& [name, table] : r.tables) table.writeCsv(options.out_dir + "/" + name + ".csv");
     if (options.plots) {

@@ -16,7 +16,11 @@ int runCommand(const std::vector<std::string>& args) {
       "override a scene value: key.path=value (repeatable; e.g. vehicle.initial_speed_m_s=12, "
       "plugins.front_steer.command.final_rad=0.05, analysis.t_end_s=5)")(
       "out", po::value<std::string>(), "output folder (default: ./results/<scene name>)")(
-      "no-plots", "write no PNG plots (gnuplot) next to the CSV files");
+      "no-plots", "write no PNG plots (gnuplot) next to the CSV files")(
+      "animation",
+      "also write animation.glb (glTF 2.0: the bodies as boxes and cylinders, their poses at every report time, "
+      "the reference path) and animation.html, a viewer that opens offline (time slider, play; #t=1.5 shows t = "
+      "1.5 s); transient analyses only (docs/animation.md)");
   addCommonOptions(opts);
   po::variables_map vm;
   if (!parseArgs(command("run"), args, opts, {"scene"}, vm)) return 0;
@@ -31,6 +35,7 @@ int runCommand(const std::vector<std::string>& args) {
   options.out_dir = vm.count("out") ? vm["out"].as<std::string>() : defaultOutputDir(scene);
   options.progress = [](const std::string& label, double tEnd) { return study::progress(label, tEnd); };
   options.plots = !vm.count("no-plots");
+  options.animation = vm.count("animation") != 0;
   installInterruptHandlers();  // SIGINT/SIGTERM: a transient stops at its next step, nothing is written
   Json summary;
   try {

@@ -47,7 +47,8 @@ TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, 
   // initial state contradicts, e.g. a speed hold at another speed.
   for (const auto& p : built.scene().getPlugins()) p->checkInitialState(built.scene(), r.final_state);
   r.vehicle = built.vehicle->describe(r.final_state);
-  if (!built.outputs.empty()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
+  // A scene with a sample observer (vdyn run --animation) is sampled even with no outputs.
+  if (!built.outputs.empty() || scene.getSampleObserver()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
   SimulationSettings sim = settings.simulation();
   for (const auto& p : scene.getPlugins())
     for (double t : p->calcInputJumpTimes()) sim.restart_times_s.push_back(t);

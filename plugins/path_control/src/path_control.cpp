@@ -333,6 +333,12 @@ const PathController& PathControlPlugin::controller() const {
   return *law_;
 }
 
+void PathControlPlugin::DoAddDecorations(SceneDecorations& decorations) const {
+  SceneDecorations::Line line{name() + ".path", {}};
+  for (const PathPoint& p : path_->sample(20.0, 40.0, 0.5)) line.p_G.push_back({p.p_G[0], p.p_G[1], 0.0});
+  decorations.lines.push_back(std::move(line));
+}
+
 void PathControlPlugin::DoAddTo(Scene& scene) {
   auto* steer = scene.findPlugin<SteeringActuator>(steering_);
   if (!steer) throw Error("path control plugin '" + name() + "': the scene has no steering plugin '" + steering_ + "'");

@@ -21,6 +21,17 @@ enum class PluginKind { ForceElement, Constraint, Controller, Analysis, Vehicle 
 /// "force element", "constraint", ... as used in messages.
 const char* toString(PluginKind kind);
 
+/// Ground-fixed things a plugin shows in an animation (vdyn/core/animation.h):
+/// a reference path as a line, cones. Positions in the ground frame G, m.
+struct SceneDecorations {
+  struct Line {
+    std::string name;
+    std::vector<SimTK::Vec3> p_G;  ///< polyline points in G, m
+  };
+  std::vector<Line> lines;
+  std::vector<SimTK::Vec3> cones_G;  ///< cone base centres in G, m
+};
+
 class Plugin {
  public:
   virtual ~Plugin() = default;
@@ -61,6 +72,10 @@ class Plugin {
   /// there (SimulationSettings::restart_times_s). Empty by default.
   std::vector<double> calcInputJumpTimes() const { return DoCalcInputJumpTimes(); }
 
+  /// Adds what the plugin shows in an animation (a path controller's reference
+  /// path) to `decorations`. Nothing by default.
+  void addDecorations(SceneDecorations& decorations) const { DoAddDecorations(decorations); }
+
  protected:
   Plugin(PluginKind kind, std::string type, std::string name);
   virtual void DoAddTo(Scene& scene) = 0;
@@ -69,6 +84,7 @@ class Plugin {
   virtual std::vector<std::string> DoGetAdjustables() const { return {}; }
   virtual void DoSetAdjustable(SimTK::State&, const std::string&, double) const {}
   virtual std::vector<double> DoCalcInputJumpTimes() const { return {}; }
+  virtual void DoAddDecorations(SceneDecorations&) const {}
 
  private:
   PluginKind kind_;

@@ -46,6 +46,7 @@ class Recorder {
   std::vector<std::string> names_;
   std::vector<const Output*> outputs_;
   SimTK::Stage stage_ = SimTK::Stage::Time;
+  Scene::SampleObserver observer_;  ///< the scene's sample observer when this recorder was made
   /// The workspace's discrete part is that of `like` (copies it if not).
   void syncWorkspace(const SimTK::State& like);
   SimTK::State work_;

@@ -61,6 +61,16 @@ class Scene {
   bool hasBody(const std::string& name) const { return bodies_.count(name) != 0; }
   /// Throws Error listing the known names if `name` is unknown.
   const SimTK::MobilizedBody& getBody(const std::string& name) const;
+  /// The named bodies' names, sorted.
+  std::vector<std::string> getBodyNames() const;
+
+  // --- sample observer (an animation's recorder) -----------------------------
+  /// Called by every Recorder of this scene at each of its samples with the
+  /// sampled state realized through Stage::Position (Recorder realizes that far
+  /// when an observer is set). Empty (the default): nothing extra is done.
+  using SampleObserver = std::function<void(const SimTK::State&)>;
+  void setSampleObserver(SampleObserver observer) { sampleObserver_ = std::move(observer); }
+  const SampleObserver& getSampleObserver() const { return sampleObserver_; }
 
   // --- services (e.g. the road) shared by plugins ---------------------------
   template <class T>
@@ -120,6 +130,7 @@ class Scene {
   SimTK::SimbodyMatterSubsystem matter_;
   SimTK::GeneralForceSubsystem forces_;
   std::map<std::string, SimTK::MobilizedBody> bodies_;
+  SampleObserver sampleObserver_;
   std::map<std::string, std::shared_ptr<const void>> services_;
   std::map<std::string, const std::type_info*> serviceTypes_;
   std::vector<std::unique_ptr<Plugin>> plugins_;

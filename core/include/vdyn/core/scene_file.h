@@ -139,6 +139,12 @@ struct RunOptions {
   ProgressFactory progress;
   /// PNG plots of the tables (plot.h, gnuplot) next to the CSV files.
   bool plots = true;
+  /// An animation of the run (vdyn/core/animation.h): animation.glb and its
+  /// viewer animation.html in out_dir, the bodies' poses X_GB sampled at the
+  /// analysis's report times. Only an analysis that runs the built scene
+  /// through a Recorder (transient) has one; others are an Error. Off: nothing
+  /// extra is recorded.
+  bool animation = false;
 };
 
 /// What a run of a scene gives: the summary (as in summary.json), the

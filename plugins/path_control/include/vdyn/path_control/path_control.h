@@ -211,6 +211,9 @@ class PathControlPlugin : public ControllerPlugin {
 
  protected:
   void DoAddTo(Scene& scene) override;
+  /// The reference path as a line on the ground (z = 0), every 0.5 m, 20 m
+  /// before its start to 40 m after its end.
+  void DoAddDecorations(SceneDecorations& decorations) const override;
 
  private:
   std::string steering_, chassis_;
