@@ -27,9 +27,9 @@ namespace {
 
 // Steer locked; tire horizontal forces (mu, slip stiffnesses), radial damping
 // and relaxation states off: the tire's force is Cz * deflection along z.
-std::vector<Override> verticalTireSteerLocked() {
+std::vector<Override> verticalTire(bool steerLock = true) {
   const std::string t = "vehicle.overrides.tire.params.";
-  return {{"vehicle.overrides.steer_lock", true},
+  return {{"vehicle.overrides.steer_lock", steerLock},
           {t + "mu_max", 0.0},
           {t + "mu_min", 0.0},
           {t + "longitudinal_stiffness_N", 0.0},
@@ -39,9 +39,9 @@ std::vector<Override> verticalTireSteerLocked() {
           {t + "relaxation_length_lateral_m", 0.0}};
 }
 
-QuarterCarParams vdynParams() {
+QuarterCarParams vdynParams(bool steerLock = true) {
   BuiltScene b = SceneDescription::fromFile("scenes/ch4_sensitivity.json", standardRegistry(),
-                                            verticalTireSteerLocked()).build();
+                                            verticalTire(steerLock)).build();
   return b.vehicleAs<QuarterCar>().params();
 }
 
@@ -69,6 +69,7 @@ QuarterCarRefData referenceData(const QuarterCarParams& p, const double b[6]) {
   d.rc_m = p.tire.getNumber("carcass_radius_m");
   d.Cz_N_per_m = b[4];
   d.road_A_m = p.road.amplitude_m, d.road_f_Hz = p.road.frequency_Hz;
+  d.steer_lock = p.steer_lock;
   return d;
 }
 
@@ -100,8 +101,11 @@ TEST(QuarterCarReference, DataMatchTheModelTheReferenceWrites) {
     EXPECT_EQ(p.tire.getNumber(k), 0.0) << k;
 }
 
-TEST(QuarterCarReference, PsiAndSensitivitiesAgreeWithVdyn) {
-  const QuarterCarParams qp = vdynParams();
+namespace {
+// psi and the six d psi / d b from both sides, asserted to 1e-6 and 1e-4; the
+// rest poses to 1e-9 m; the reference's RK4 step by halving it.
+void compareWithVdyn(bool steerLock, int steerWalk = 0) {
+  const QuarterCarParams qp = vdynParams(steerLock);
   const double b0[6] = {qp.chassis_mass_kg, qp.corner.knuckle.mass_kg, qp.corner.spring_stiffness_N_per_m,
                         qp.corner.damper_N_s_per_m, qp.tire.getNumber("radial_stiffness_N_per_m"),
                         qp.upper_pivot_offset_m};
@@ -111,15 +115,22 @@ TEST(QuarterCarReference, PsiAndSensitivitiesAgreeWithVdyn) {
     const QuarterCar car(qp);
     const SimTK::State s = car.makeInitialState(true);
     QuarterCarReference ref(referenceData(qp, b0));
-    const QuarterCarReference::Run r = ref.simulate(1e-3, 1e-4);
+    const QuarterCarReference::Run r = ref.simulate(1e-3, 1e-4, steerWalk);
     std::printf("  rest pose: chassis z reference %.12f m, vdyn %.12f m (difference %.2e m)\n", r.z0_m,
                 car.chassis().getOneQ(s, 0), r.z0_m - car.chassis().getOneQ(s, 0));
     EXPECT_NEAR(r.z0_m, car.chassis().getOneQ(s, 0), 1e-9);
+    if (!steerLock) {
+      // The steer at rest: the spin axis's forward component in both.
+      const SimTK::Vec3 s_G = car.corner().knuckle.getBodyRotation(s) * qp.corner.wheel_spin_axis;
+      std::printf("  rest steer: s_G . x_G reference %.12f (its walk stopped at %.2f; Q_sigma %.4g -> %.4g), "
+                  "vdyn %.12f\n", r.sigma0, r.sigma_walk, r.Q_sigma_before_N, r.Q_sigma_after_N, s_G[0]);
+      EXPECT_NEAR(r.sigma0, s_G[0], 1e-9);
+    }
   }
 
   // vdyn: the scene's sensitivity problem, fd_central at accuracy 1e-10.
   const SceneDescription scene =
-      SceneDescription::fromFile("scenes/ch4_sensitivity.json", standardRegistry(), verticalTireSteerLocked());
+      SceneDescription::fromFile("scenes/ch4_sensitivity.json", standardRegistry(), verticalTire(steerLock));
   SensitivityProblem p;
   p.model = SceneDesign::fromAnalysis(scene);
   p.parameters = {"m1", "m3", "K", "D", "Cz", "s'"};
@@ -139,7 +150,7 @@ TEST(QuarterCarReference, PsiAndSensitivitiesAgreeWithVdyn) {
   // The reference, the same designs.
   auto psiRef = [&](const double b[6], double dt, QuarterCarReference::Run* out = nullptr) {
     QuarterCarReference ref(referenceData(qp, b));
-    const QuarterCarReference::Run r = ref.simulate(kT, dt);
+    const QuarterCarReference::Run r = ref.simulate(kT, dt, steerWalk);
     if (out) *out = r;
     return r.psi;
   };
@@ -147,9 +158,9 @@ TEST(QuarterCarReference, PsiAndSensitivitiesAgreeWithVdyn) {
   const double psi = psiRef(b0, kDt, &nominal);
   const double psiHalf = psiRef(b0, kDt / 2);  // RK4 step check
   std::printf("  reference: psi %.12g (step %.0e), %.12g (step %.0e): relative %.2e; loop residual <= %.1e m, "
-              "tire load >= %.1f N\n",
+              "tire load >= %.1f N, |s_G . x_G| <= %.2e\n",
               psi, kDt, psiHalf, kDt / 2, std::abs(psi - psiHalf) / psi, nominal.max_loop_residual_m,
-              nominal.min_Fz_N);
+              nominal.min_Fz_N, nominal.max_abs_sigma);
   EXPECT_LT(std::abs(psi - psiHalf) / psi, 1e-8);
   EXPECT_LT(nominal.max_loop_residual_m, 1e-12);
   EXPECT_GT(nominal.min_Fz_N, 0.0);  // in contact throughout: the force law is smooth
@@ -168,4 +179,18 @@ TEST(QuarterCarReference, PsiAndSensitivitiesAgreeWithVdyn) {
                 v.dpsi_db[i], rel);
     EXPECT_LT(rel, 1e-4) << p.parameters[i];
   }
+}
+}  // namespace
+
+TEST(QuarterCarReference, SteerLockedPsiAndSensitivitiesAgreeWithVdyn) { compareWithVdyn(true); }
+
+TEST(QuarterCarReference, SteerFreePsiAndSensitivitiesAgreeWithVdyn) {
+  // The seed's four degrees of freedom: the knuckle turns about its kingpin,
+  // sigma = s_G . x_G the reference's fourth coordinate. With no horizontal
+  // tire force nothing centres the steer: vdyn's static solve (Newton from the
+  // straight-ahead pose) lands where the steer's generalized force first
+  // vanishes on the +sigma side, sigma = 0.7526 (about 49 deg of steer); the
+  // reference walks sigma that way to the same root. (The force at sigma = 0
+  // pushes to -sigma, to another rest pose near sigma = -0.977.)
+  compareWithVdyn(false, +1);
 }

@@ -58,6 +58,9 @@ struct QuarterCarRefData {
   Vec3 p_CS{0}, p_AS{0};  ///< spring: chassis point, lower-arm point
   double R0_m = 0, rc_m = 0, Cz_N_per_m = 0;  ///< tire unloaded radius, carcass radius, radial stiffness
   double road_A_m = 0, road_f_Hz = 0;
+  /// true: g3 = (R_GK s_K) . x_G = 0 (3 dof); false: the knuckle steers freely
+  /// about its kingpin (4 dof), sigma = (R_GK s_K) . x_G a fourth coordinate.
+  bool steer_lock = true;
 };
 
 inline Mat33 skew(const Vec3& v) { return Mat33(0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0); }
@@ -107,18 +110,24 @@ class QuarterCarReference {
   /// Knuckle (and wheel) origin in the chassis frame at design, through the tree joints.
   Vec3 wheelCentreInChassis() const { return d_.p_CP1 - d_.p_AP1 + d_.p_AB2 - d_.p_KB2; }
 
+  /// Independent speeds: 3 with the steer locked, 4 with it free.
+  int speeds() const { return d_.steer_lock ? 3 : 4; }
+
   struct Eval {
-    double udot[3];   ///< [z'', theta1'', phi'']
-    double Qr[3];     ///< reduced generalized force at u' = 0 (static residual when u = 0)
+    double udot[4] = {0, 0, 0, 0};  ///< [z'', theta1'', phi'', sigma'']
+    double Qr[4] = {0, 0, 0, 0};    ///< reduced generalized force at u' = 0 (static residual when u = 0)
     double Fz_N = 0;  ///< tire normal force
     double loop_residual_m = 0;
     int newton_iterations = 0;
   };
 
-  /// The accelerations at time t_s for q = [z, theta1], u = [z', theta1', phi'].
-  Eval evaluate(double t_s, const double q[2], const double u[3]) {
+  /// The accelerations at time t_s for q = [z, theta1, sigma], u = [z', theta1', phi', sigma']
+  /// (sigma, sigma' read only with the steer free).
+  Eval evaluate(double t_s, const double q[3], const double u_in[4]) {
     Eval e;
-    const double z = q[0], th1 = q[1];
+    const int nu = speeds();
+    const double z = q[0], th1 = q[1], sigma = d_.steer_lock ? 0.0 : q[2];
+    const double u[4] = {u_in[0], u_in[1], u_in[2], d_.steer_lock ? 0.0 : u_in[3]};
     const Vec3 ez(0, 0, 1), ex(1, 0, 0);
     const Vec3 dz(0, 0, z);
     // Lower arm (joint 1): R_GA = rot(a1, theta1), c.m. and ball point in G.
@@ -135,7 +144,7 @@ class QuarterCarReference {
       const Vec3 r2 = R_GK_ * d_.p_KB2, r3 = R_GK_ * d_.p_KB3, s_G = R_GK_ * d_.s_K;
       const Vec3 g1 = p_GB2 - (p_GK_ + r2), g2 = p_GB3 - (p_GK_ + r3);
       for (int i = 0; i < 3; ++i) g[i] = g1[i], g[3 + i] = g2[i];
-      g[6] = SimTK::dot(s_G, ex);
+      g[6] = SimTK::dot(s_G, ex) - sigma;
       for (double& x : J) x = 0;
       const Mat33 S2 = skew(r2), S3 = skew(r3);
       const Vec3 t4 = SimTK::cross(d_.a4_C, p_GB3 - p_GP4);
@@ -174,23 +183,27 @@ class QuarterCarReference {
     const Vec3 p_GB3 = p_GP4 + R_GU * (d_.p_UB3 - d_.p_UP4);
     const Vec3 r2 = R_GK_ * d_.p_KB2, r3 = R_GK_ * d_.p_KB3, s_G = R_GK_ * d_.s_K;
 
-    // Velocities: w = [z', theta1', phi', theta4', v_GK (3), w_GK (3)] = S u.
-    // A_i (7 x 3) on [z', theta1', phi']; A_d = J on [theta4', v_GK, w_GK].
-    std::vector<double> Ai(21, 0.0);
+    // Velocities: w = [z', theta1', phi', sigma', theta4', v_GK (3), w_GK (3)] = S u.
+    // A_i (7 x 4) on [z', theta1', phi', sigma']; A_d = J on [theta4', v_GK, w_GK].
+    std::vector<double> Ai(28, 0.0);
     const Vec3 t1 = SimTK::cross(d_.a1_C, p_GB2 - p_GP1);
     for (int i = 0; i < 3; ++i) {
-      Ai[i * 3 + 0] = ez[i];
-      Ai[i * 3 + 1] = t1[i];
-      Ai[(3 + i) * 3 + 0] = ez[i];
+      Ai[i * 4 + 0] = ez[i];
+      Ai[i * 4 + 1] = t1[i];
+      Ai[(3 + i) * 4 + 0] = ez[i];
     }
-    std::vector<double> Sd(21);
-    for (int i = 0; i < 21; ++i) Sd[i] = -Ai[i];
+    Ai[6 * 4 + 3] = -1;  // g3 = s_G . x_G - sigma
+    std::vector<double> Sd(28);
+    for (int i = 0; i < 28; ++i) Sd[i] = -Ai[i];
     std::vector<double> Jd(J, J + 49);
-    solveDense(7, Jd, Sd, 3);  // S_d = -A_d^-1 A_i
-    double w[10] = {u[0], u[1], u[2]};
-    for (int i = 0; i < 7; ++i) w[3 + i] = Sd[i * 3] * u[0] + Sd[i * 3 + 1] * u[1] + Sd[i * 3 + 2] * u[2];
-    const double th1d = u[1], phid = u[2], th4d = w[3];
-    const Vec3 w_GK(w[7], w[8], w[9]);
+    solveDense(7, Jd, Sd, 4);  // S_d = -A_d^-1 A_i
+    double w[11] = {u[0], u[1], u[2], u[3]};
+    for (int i = 0; i < 7; ++i) {
+      w[4 + i] = 0;
+      for (int j = 0; j < 4; ++j) w[4 + i] += Sd[i * 4 + j] * u[j];
+    }
+    const double th1d = u[1], phid = u[2], th4d = w[4];
+    const Vec3 w_GK(w[8], w[9], w[10]);
     // gamma = (d/dt A) w: the velocity-product terms of the loop's accelerations.
     const Vec3 gam1 = th1d * th1d * SimTK::cross(d_.a1_C, SimTK::cross(d_.a1_C, p_GB2 - p_GP1)) -
                       SimTK::cross(w_GK, SimTK::cross(w_GK, r2));
@@ -202,26 +215,26 @@ class QuarterCarReference {
     cd[6] = -gam3;
     Jd.assign(J, J + 49);
     solveDense(7, Jd, cd, 1);  // c_d = -A_d^-1 gamma
-    // S (10 x 3) and c (10): w' = S u' + c.
-    double S[10][3] = {{1, 0, 0}, {0, 1, 0}, {0, 0, 1}}, c[10] = {0, 0, 0};
+    // S (11 x 4) and c (11): w' = S u' + c.
+    double S[11][4] = {{1, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, 0, 0, 1}}, c[11] = {0, 0, 0, 0};
     for (int i = 0; i < 7; ++i) {
-      for (int j = 0; j < 3; ++j) S[3 + i][j] = Sd[i * 3 + j];
-      c[3 + i] = cd[i];
+      for (int j = 0; j < 4; ++j) S[4 + i][j] = Sd[i * 4 + j];
+      c[4 + i] = cd[i];
     }
 
     // Bodies: v_b = Bv w, w_b = Bw w, a_b = Bv w' + kv, alpha_b = Bw w' + kw.
-    double M[10][10] = {}, F[10] = {};
+    double M[11][11] = {}, F[11] = {};
     struct BodyTerms {
       double m;
       Mat33 I_G;
       Vec3 p_G;            // c.m.
-      double Bv[3][10], Bw[3][10];
+      double Bv[3][11], Bw[3][11];
       Vec3 kv, kw;
       Vec3 F, T;           // applied force at the c.m. and moment about it
     };
     auto zero = [](BodyTerms& b) {
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 10; ++j) b.Bv[i][j] = b.Bw[i][j] = 0;
+        for (int j = 0; j < 11; ++j) b.Bv[i][j] = b.Bw[i][j] = 0;
       b.kv = b.kw = b.F = b.T = Vec3(0);
     };
     auto inertia = [](const QcBody& b, const Mat33& R) {
@@ -243,7 +256,7 @@ class QuarterCarReference {
     ua.m = d_.upper_arm.m_kg, ua.I_G = inertia(d_.upper_arm, R_GU), ua.p_G = p_GU;
     {
       const Vec3 r = p_GU - p_GP4, t = SimTK::cross(d_.a4_C, r);
-      for (int i = 0; i < 3; ++i) ua.Bv[i][3] = t[i], ua.Bw[i][3] = d_.a4_C[i];
+      for (int i = 0; i < 3; ++i) ua.Bv[i][4] = t[i], ua.Bw[i][4] = d_.a4_C[i];
       ua.Bv[2][0] = 1;
       ua.kv = th4d * th4d * SimTK::cross(d_.a4_C, SimTK::cross(d_.a4_C, r));
     }
@@ -251,15 +264,15 @@ class QuarterCarReference {
     // The wheel is axisymmetric about its spin axis: R_GW I_W R_GW^T = R_GK I_W R_GK^T.
     wh.m = d_.wheel.m_kg, wh.I_G = inertia(d_.wheel, R_GK_), wh.p_G = p_GK_;
     for (int i = 0; i < 3; ++i) {
-      kn.Bv[i][4 + i] = kn.Bw[i][7 + i] = 1;
-      wh.Bv[i][4 + i] = wh.Bw[i][7 + i] = 1;
+      kn.Bv[i][5 + i] = kn.Bw[i][8 + i] = 1;
+      wh.Bv[i][5 + i] = wh.Bw[i][8 + i] = 1;
       wh.Bw[i][2] = s_G[i];
     }
     wh.kw = phid * SimTK::cross(w_GK, s_G);
     auto velocity = [&](const BodyTerms& b, Vec3& v, Vec3& om) {
       v = om = Vec3(0);
       for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 10; ++j) v[i] += b.Bv[i][j] * w[j], om[i] += b.Bw[i][j] * w[j];
+        for (int j = 0; j < 11; ++j) v[i] += b.Bv[i][j] * w[j], om[i] += b.Bw[i][j] * w[j];
     };
     // Gravity (all bodies).
     for (BodyTerms* b : {&ch, &la, &ua, &kn, &wh}) b->F += Vec3(0, 0, -b->m * gr);
@@ -296,15 +309,15 @@ class QuarterCarReference {
         wh.T += SimTK::cross(p_GC - p_GK_, Fc);
       }
     }
-    // Assemble M (10 x 10) and F (10): F - (m kv; I kw + w x I w) projected.
+    // Assemble M (11 x 11) and F (11): F - (m kv; I kw + w x I w) projected.
     for (BodyTerms* b : {&ch, &la, &ua, &kn, &wh}) {
       Vec3 v, om;
       velocity(*b, v, om);
       const Vec3 fl = b->F - b->m * b->kv;
       const Vec3 tl = b->T - b->I_G * b->kw - SimTK::cross(om, b->I_G * om);
-      for (int j = 0; j < 10; ++j) {
+      for (int j = 0; j < 11; ++j) {
         for (int i = 0; i < 3; ++i) F[j] += b->Bv[i][j] * fl[i] + b->Bw[i][j] * tl[i];
-        for (int k = 0; k < 10; ++k) {
+        for (int k = 0; k < 11; ++k) {
           double s = 0;
           for (int i = 0; i < 3; ++i) {
             s += b->m * b->Bv[i][j] * b->Bv[i][k];
@@ -314,91 +327,126 @@ class QuarterCarReference {
         }
       }
     }
-    // Reduce: M_r = S^T M S, Q_r = S^T (F - M c).
-    std::vector<double> Mr(9, 0.0), Qr(3, 0.0);
-    double Fc[10];
-    for (int j = 0; j < 10; ++j) {
+    // Reduce over the nu active speeds: M_r = S^T M S, Q_r = S^T (F - M c).
+    std::vector<double> Mr(nu * nu, 0.0), Qr(nu, 0.0);
+    double Fc[11];
+    for (int j = 0; j < 11; ++j) {
       Fc[j] = F[j];
-      for (int k = 0; k < 10; ++k) Fc[j] -= M[j][k] * c[k];
+      for (int k = 0; k < 11; ++k) Fc[j] -= M[j][k] * c[k];
     }
-    for (int a = 0; a < 3; ++a) {
-      for (int j = 0; j < 10; ++j) Qr[a] += S[j][a] * Fc[j];
-      for (int b = 0; b < 3; ++b)
-        for (int j = 0; j < 10; ++j)
-          for (int k = 0; k < 10; ++k) Mr[a * 3 + b] += S[j][a] * M[j][k] * S[k][b];
+    for (int a = 0; a < nu; ++a) {
+      for (int j = 0; j < 11; ++j) Qr[a] += S[j][a] * Fc[j];
+      for (int b = 0; b < nu; ++b)
+        for (int j = 0; j < 11; ++j)
+          for (int k = 0; k < 11; ++k) Mr[a * nu + b] += S[j][a] * M[j][k] * S[k][b];
     }
-    for (int a = 0; a < 3; ++a) e.Qr[a] = Qr[a];
-    solveDense(3, Mr, Qr, 1);
-    for (int a = 0; a < 3; ++a) e.udot[a] = Qr[a];
+    for (int a = 0; a < nu; ++a) e.Qr[a] = Qr[a];
+    solveDense(nu, Mr, Qr, 1);
+    for (int a = 0; a < nu; ++a) e.udot[a] = Qr[a];
     return e;
   }
 
   /// Static equilibrium at t = 0 with u = 0: Newton on the reduced generalized
-  /// force [Q_z, Q_theta1] (central-difference Jacobian). q holds the start.
-  void solveStatic(double q[2], double tol_N = 1e-9) {
-    const double u[3] = {0, 0, 0};
+  /// forces of the coordinates [z, theta1 (, sigma)] (central-difference
+  /// Jacobian; phi' has no force). q holds the start.
+  /// `hold_sigma`: the steer held at q[2] (the rest of the corner at rest).
+  void solveStatic(double q[3], double tol = 1e-9, bool hold_sigma = false) {
+    const double u[4] = {0, 0, 0, 0};
+    const int n = d_.steer_lock || hold_sigma ? 2 : 3;
+    const int row[3] = {0, 1, 3};  // the speeds of z, theta1, sigma
     for (int it = 0; it < 50; ++it) {
       const Eval e0 = evaluate(0, q, u);
-      if (std::abs(e0.Qr[0]) < tol_N && std::abs(e0.Qr[1]) < tol_N) return;
-      std::vector<double> Jm(4);
-      const double h[2] = {1e-7, 1e-7};
-      for (int j = 0; j < 2; ++j) {
-        double qp[2] = {q[0], q[1]}, qm[2] = {q[0], q[1]};
-        qp[j] += h[j], qm[j] -= h[j];
+      double res = 0;
+      for (int i = 0; i < n; ++i) res = std::max(res, std::abs(e0.Qr[row[i]]));
+      if (res < tol) return;
+      std::vector<double> Jm(n * n), b(n);
+      for (int j = 0; j < n; ++j) {
+        double qp[3] = {q[0], q[1], q[2]}, qm[3] = {q[0], q[1], q[2]};
+        qp[j] += 1e-7, qm[j] -= 1e-7;
         const Eval ep = evaluate(0, qp, u), em = evaluate(0, qm, u);
-        for (int i = 0; i < 2; ++i) Jm[i * 2 + j] = (ep.Qr[i] - em.Qr[i]) / (2 * h[j]);
+        for (int i = 0; i < n; ++i) Jm[i * n + j] = (ep.Qr[row[i]] - em.Qr[row[i]]) / 2e-7;
       }
-      std::vector<double> b = {-e0.Qr[0], -e0.Qr[1]};
-      solveDense(2, Jm, b, 1);
-      q[0] += b[0], q[1] += b[1];
+      for (int i = 0; i < n; ++i) b[i] = -e0.Qr[row[i]];
+      solveDense(n, Jm, b, 1);
+      for (int i = 0; i < n; ++i) q[i] += b[i];
     }
     throw std::runtime_error("quarter car reference: static equilibrium did not converge");
   }
 
   struct Run {
     double psi = 0;       ///< int_0^T z''^2 dt (4.46), m^2/s^3
-    double z0_m = 0, theta1_0_rad = 0;
+    double z0_m = 0, theta1_0_rad = 0, sigma0 = 0;
+    double max_abs_sigma = 0;
+    double sigma_walk = 0;     ///< where the steer walk stopped (steer free)
+    /// The steer's generalized force one walk step before and at the stop: a
+    /// rise through 0 with sigma (-, then + for a walk to +sigma) is an
+    /// unstable rest pose (negative stiffness), a fall a stable one.
+    double Q_sigma_before_N = 0, Q_sigma_after_N = 0;  ///< largest |s_G . x_G| of the run (0 with the steer locked)
     double max_loop_residual_m = 0;
     double min_Fz_N = 1e300;
     int steps = 0;
   };
 
   /// From static equilibrium at t = 0, classical RK4 with a fixed step dt over
-  /// [0, T]; psi is a fifth state integrated with the same stages.
-  Run simulate(double T_s, double dt_s) {
+  /// [0, T]; psi is a further state integrated with the same stages. With the
+  /// steer free, the static solve starts from the steer found by walking sigma
+  /// from 0 in steps of 0.01, the rest of the corner at rest at each, in the
+  /// direction `steer_walk` (+1 or -1; 0: the way its generalized force pushes
+  /// at sigma = 0), until that force changes sign. Without horizontal tire
+  /// forces the free steer has more than one rest pose (docs/table_4_1.md).
+  Run simulate(double T_s, double dt_s, int steer_walk = 0) {
     Run r;
-    resetLoopGuess();
-    double q[2] = {d_.R0_m - wheelCentreInChassis()[2], 0.0};
+    double q[3] = {d_.R0_m - wheelCentreInChassis()[2], 0.0, 0.0};
     resetLoopGuess(q[0]);
+    if (!d_.steer_lock) {
+      const double u0[4] = {0, 0, 0, 0};
+      solveStatic(q, 1e-9, true);
+      const double Q0 = evaluate(0, q, u0).Qr[3];
+      const double dir = steer_walk != 0 ? steer_walk : (Q0 > 0 ? 1 : -1);
+      r.Q_sigma_before_N = Q0;
+      for (int k = 1; k < 99; ++k) {
+        q[2] = dir * 0.01 * k;
+        solveStatic(q, 1e-9, true);
+        const double Q = evaluate(0, q, u0).Qr[3];
+        if (Q * r.Q_sigma_before_N <= 0) {
+          r.Q_sigma_after_N = Q;
+          break;
+        }
+        r.Q_sigma_before_N = Q;
+      }
+      r.sigma_walk = q[2];
+    }
     solveStatic(q);
-    r.z0_m = q[0], r.theta1_0_rad = q[1];
+    r.z0_m = q[0], r.theta1_0_rad = q[1], r.sigma0 = q[2];
     const int n = static_cast<int>(std::llround(T_s / dt_s));
     const double h = T_s / n;
-    // y = [z, theta1, z', theta1', phi', psi]
-    double y[6] = {q[0], q[1], 0, 0, 0, 0};
+    // y = [z, theta1, sigma, z', theta1', phi', sigma', psi]
+    constexpr int N = 8;
+    double y[N] = {q[0], q[1], q[2], 0, 0, 0, 0, 0};
     auto f = [&](double t, const double* yy, double* dy) {
-      const double qq[2] = {yy[0], yy[1]}, uu[3] = {yy[2], yy[3], yy[4]};
+      const double qq[3] = {yy[0], yy[1], yy[2]}, uu[4] = {yy[3], yy[4], yy[5], yy[6]};
       const Eval e = evaluate(t, qq, uu);
       r.max_loop_residual_m = std::max(r.max_loop_residual_m, e.loop_residual_m);
       r.min_Fz_N = std::min(r.min_Fz_N, e.Fz_N);
-      dy[0] = yy[2], dy[1] = yy[3];
-      dy[2] = e.udot[0], dy[3] = e.udot[1], dy[4] = e.udot[2];
-      dy[5] = e.udot[0] * e.udot[0];
+      r.max_abs_sigma = std::max(r.max_abs_sigma, std::abs(qq[2]));
+      dy[0] = yy[3], dy[1] = yy[4], dy[2] = d_.steer_lock ? 0.0 : yy[6];
+      for (int i = 0; i < 4; ++i) dy[3 + i] = e.udot[i];
+      dy[7] = e.udot[0] * e.udot[0];
     };
-    double k1[6], k2[6], k3[6], k4[6], yt[6];
+    double k1[N], k2[N], k3[N], k4[N], yt[N];
     for (int s = 0; s < n; ++s) {
       const double t = s * h;
       f(t, y, k1);
-      for (int i = 0; i < 6; ++i) yt[i] = y[i] + 0.5 * h * k1[i];
+      for (int i = 0; i < N; ++i) yt[i] = y[i] + 0.5 * h * k1[i];
       f(t + 0.5 * h, yt, k2);
-      for (int i = 0; i < 6; ++i) yt[i] = y[i] + 0.5 * h * k2[i];
+      for (int i = 0; i < N; ++i) yt[i] = y[i] + 0.5 * h * k2[i];
       f(t + 0.5 * h, yt, k3);
-      for (int i = 0; i < 6; ++i) yt[i] = y[i] + h * k3[i];
+      for (int i = 0; i < N; ++i) yt[i] = y[i] + h * k3[i];
       f(t + h, yt, k4);
-      for (int i = 0; i < 6; ++i) y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
+      for (int i = 0; i < N; ++i) y[i] += h / 6 * (k1[i] + 2 * k2[i] + 2 * k3[i] + k4[i]);
     }
     r.steps = n;
-    r.psi = y[5];
+    r.psi = y[7];
     return r;
   }
 
