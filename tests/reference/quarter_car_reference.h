@@ -1,6 +1,6 @@
 #pragma once
-// A test-only second formulation of the seed's chapter 4 quarter car with the
-// steer locked (issue 25 item 1; docs/table_4_1.md, "The second formulation"):
+// A test-only second formulation of the seed's chapter 4 quarter car, steer
+// locked or free (issue 25 item 1; docs/table_4_1.md, "The second formulation"):
 // the chassis on its vertical slider and the App. A double-wishbone corner,
 // written in minimal coordinates and integrated by its own fixed-step RK4. It
 // uses no vdyn model and none of Simbody's multibody or constraint code, only
@@ -21,6 +21,9 @@
 // d/dt (A w). The equations of motion are Kane's (virtual power):
 //   sum_b [ (dv_b/du)^T (m_b a_b - F_b) + (dw_b/du)^T (I_b alpha_b + w_b x I_b w_b - T_b) ] = 0,
 // which reduce to M_r(q) u' = Q_r(q, u, t), M_r = S^T M S, S = dw/du.
+// With the steer free (QuarterCarRefData::steer_lock false, the seed's four
+// degrees of freedom) g3 becomes (R_GK s_K) . x_G - sigma = 0 and sigma, sigma'
+// are a fourth coordinate and speed.
 //
 // Forces: gravity on every body; the spring-damper between its chassis point
 // and its lower-arm point, f = K (l - l0) + D l' along the line (4.43); the tire
