@@ -80,7 +80,7 @@ const double kScale[6] = {100, 5, 1e4, 1e3, 1e5, 0.01};  // the scene's scales
 
 }  // namespace
 
-TEST(QuarterCarReference, DataMatchTheModelTheReferenceWrites) {
+TEST(QuarterCarReference, DataAreWhatTheReferenceModels) {
   // What the reference assumes of vdyn's data: the App. A bodies' c.m. at their
   // frames' origins, both pivots' axes along x, s' on the arm, the tire's
   // horizontal forces and radial damping off, a sine road from rest at t = 0.

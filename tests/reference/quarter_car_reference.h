@@ -11,7 +11,7 @@
 // wheel spin; the wheel is axisymmetric about its spin axis, so its spin angle
 // enters nothing). Dependent: the upper arm angle theta4, the knuckle's centre
 // of mass p_GK and orientation R_GK, found each evaluation by Newton on the
-// loop equations (seed (2.x) closure written on hardpoints):
+// loop equations, written on the hardpoints:
 //   g1 = p_G(lower ball on arm) - p_G(lower ball on knuckle) = 0   (joint 2)
 //   g2 = p_G(upper ball on arm) - p_G(upper ball on knuckle) = 0   (joint 3)
 //   g3 = (R_GK s_K) . x_G = 0                                     (steer lock)
@@ -66,12 +66,15 @@ struct QuarterCarRefData {
   bool steer_lock = true;
 };
 
+/// The 3 x 3 identity, written out (Mat33(1) trips GCC's -Warray-bounds in SimTK's Vec.h).
+inline Mat33 identity3() { return Mat33(1, 0, 0, 0, 1, 0, 0, 0, 1); }
+
 inline Mat33 skew(const Vec3& v) { return Mat33(0, -v[2], v[1], v[2], 0, -v[0], -v[1], v[0], 0); }
 
 /// Rotation by angle t about unit axis a (Rodrigues).
 inline Mat33 rotation(const Vec3& a, double t) {
   const Mat33 A = skew(a);
-  return Mat33(1) + std::sin(t) * A + (1 - std::cos(t)) * (A * A);
+  return identity3() + std::sin(t) * A + (1 - std::cos(t)) * (A * A);
 }
 
 /// Gaussian elimination with partial pivoting on a dense n x n row-major A; solves A X = B for nrhs columns.
@@ -107,7 +110,7 @@ class QuarterCarReference {
   /// knuckle unrotated at the wheel centre), at chassis height z.
   void resetLoopGuess(double z = 0) {
     th4_ = 0;
-    R_GK_ = Mat33(1);
+    R_GK_ = identity3();
     p_GK_ = wheelCentreInChassis() + Vec3(0, 0, z);
   }
   /// Knuckle (and wheel) origin in the chassis frame at design, through the tree joints.
@@ -247,7 +250,7 @@ class QuarterCarReference {
     const double gr = d_.gravity_m_per_s2;
     BodyTerms ch, la, ua, kn, wh;
     for (BodyTerms* b : {&ch, &la, &ua, &kn, &wh}) zero(*b);
-    ch.m = d_.chassis_mass_kg, ch.I_G = Mat33(1), ch.p_G = dz;
+    ch.m = d_.chassis_mass_kg, ch.I_G = identity3(), ch.p_G = dz;
     ch.Bv[2][0] = 1;
     la.m = d_.lower_arm.m_kg, la.I_G = inertia(d_.lower_arm, R_GA), la.p_G = p_GA;
     {
@@ -457,7 +460,7 @@ class QuarterCarReference {
   QuarterCarRefData d_;
   double th4_ = 0;
   Vec3 p_GK_{0};
-  Mat33 R_GK_{1};
+  Mat33 R_GK_ = identity3();
 };
 
 }  // namespace vdyn_reference
