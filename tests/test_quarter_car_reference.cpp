@@ -123,8 +123,14 @@ void compareWithVdyn(bool steerLock, int steerWalk = 0) {
       // The steer at rest: the spin axis's forward component in both.
       const SimTK::Vec3 s_G = car.corner().knuckle.getBodyRotation(s) * qp.corner.wheel_spin_axis;
       std::printf("  rest steer: s_G . x_G reference %.12f (its walk stopped at %.2f; Q_sigma %.4g -> %.4g), "
-                  "vdyn %.12f\n", r.sigma0, r.sigma_walk, r.Q_sigma_before_N, r.Q_sigma_after_N, s_G[0]);
+                  "vdyn %.12f\n", r.sigma0, r.sigma_walk, r.Q_sigma_before_N_m, r.Q_sigma_after_N_m, s_G[0]);
       EXPECT_NEAR(r.sigma0, s_G[0], 1e-9);
+      // The steer's generalized force rises through 0 along +sigma there: a
+      // negative steer stiffness, an unstable rest pose (docs/table_4_1.md).
+      if (steerWalk > 0) {
+        EXPECT_LT(r.Q_sigma_before_N_m, 0.0);
+        EXPECT_GT(r.Q_sigma_after_N_m, 0.0);
+      }
     }
   }
 

@@ -382,12 +382,12 @@ class QuarterCarReference {
   struct Run {
     double psi = 0;       ///< int_0^T z''^2 dt (4.46), m^2/s^3
     double z0_m = 0, theta1_0_rad = 0, sigma0 = 0;
-    double max_abs_sigma = 0;
+    double max_abs_sigma = 0;  ///< largest |s_G . x_G| of the run (0 with the steer locked)
     double sigma_walk = 0;     ///< where the steer walk stopped (steer free)
     /// The steer's generalized force one walk step before and at the stop: a
     /// rise through 0 with sigma (-, then + for a walk to +sigma) is an
     /// unstable rest pose (negative stiffness), a fall a stable one.
-    double Q_sigma_before_N = 0, Q_sigma_after_N = 0;  ///< largest |s_G . x_G| of the run (0 with the steer locked)
+    double Q_sigma_before_N_m = 0, Q_sigma_after_N_m = 0;
     double max_loop_residual_m = 0;
     double min_Fz_N = 1e300;
     int steps = 0;
@@ -409,16 +409,16 @@ class QuarterCarReference {
       solveStatic(q, 1e-9, true);
       const double Q0 = evaluate(0, q, u0).Qr[3];
       const double dir = steer_walk != 0 ? steer_walk : (Q0 > 0 ? 1 : -1);
-      r.Q_sigma_before_N = Q0;
+      r.Q_sigma_before_N_m = Q0;
       for (int k = 1; k < 99; ++k) {
         q[2] = dir * 0.01 * k;
         solveStatic(q, 1e-9, true);
         const double Q = evaluate(0, q, u0).Qr[3];
-        if (Q * r.Q_sigma_before_N <= 0) {
-          r.Q_sigma_after_N = Q;
+        if (Q * r.Q_sigma_before_N_m <= 0) {
+          r.Q_sigma_after_N_m = Q;
           break;
         }
-        r.Q_sigma_before_N = Q;
+        r.Q_sigma_before_N_m = Q;
       }
       r.sigma_walk = q[2];
     }
