@@ -137,7 +137,10 @@ struct LinearFourWs {
     // a, b from the whole vehicle's centre of mass and the wheel centres.
     const SimTK::SimbodyMatterSubsystem& m = sc.getMatter();
     const SimTK::Vec3 com = m.calcSystemMassCenterLocationInGround(straight.state);
-    auto wheelX = [&](int c) { return car->corner(c).wheel.getBodyOriginLocation(straight.state)[0]; };
+    // The wheel bodies by name: every template (and formulation) has them.
+    auto wheelX = [&](int c) {
+      return sc.getBody(car->cornerName(c) + ".wheel").getBodyOriginLocation(straight.state)[0];
+    };
     lin.mass_kg = car->totalMass();
     lin.front_axle_to_com_m = 0.5 * (wheelX(RF) + wheelX(LF)) - com[0];
     lin.rear_axle_to_com_m = com[0] - 0.5 * (wheelX(RR) + wheelX(LR));
