@@ -101,7 +101,7 @@ INSTANTIATE_TEST_SUITE_P(
                       StudyCase{"ch7_open_loop", "", 1}, StudyCase{"ch7_closed_loop", "", 1},
                       StudyCase{"ch8_maneuvers", "--scenario lc1,j1 --strategy 2ws,linear", 1},
                       StudyCase{"ch6_steering_ratio", "--speeds-m-s 12,20", 1},
-                      StudyCase{"ch4_sensitivity", "--method fd_forward,mixed", 1},
+                      StudyCase{"ch4_sensitivity", "--method fd_forward,reference --params m1,K", 1},
                       StudyCase{"handling", "--vehicle bicycle", 1}),
     [](const ::testing::TestParamInfo<StudyCase>& i) { return i.param.study; });
 

@@ -232,8 +232,8 @@ Json iso7401(const Config& c, const std::string& vehicle, const std::string& out
                   {{stepCsv, "t_s", "yaw_rate_rad_s", "yaw rate"}}},
                  {out + "/iso7401_step_ay_" + t + ".png", "ISO 7401 step steer " + vehicle, "t (s)", "a_y (m/s^2)",
                   {{stepCsv, "t_s", "lateral_accel_m_s2", "lateral acceleration"}}},
-                 {out + "/iso7401_gain_" + t + ".png", "ISO 7401 frequency response " + vehicle + " (gain / gain at 0.1 Hz)",
-                  "f (Hz)", "gain", {{frCsv, "frequency_Hz", "yaw_gain_1_per_s", "yaw rate (1/s)"}}, false, true, false, true},
+                 {out + "/iso7401_gain_" + t + ".png", "ISO 7401 frequency response " + vehicle + ": yaw-rate gain",
+                  "f (Hz)", "yaw-rate gain r / delta (1/s)", {{frCsv, "frequency_Hz", "yaw_gain_1_per_s", "yaw rate (1/s)"}}, false, true, false, true},
                  {out + "/iso7401_phase_" + t + ".png", "ISO 7401 frequency response " + vehicle, "f (Hz)", "phase (deg)",
                   {{frCsv, "frequency_Hz", "yaw_phase_deg", "yaw rate"}, {frCsv, "frequency_Hz", "ay_phase_deg", "a_y"}},
                   false, true, false, true}});
