@@ -19,6 +19,7 @@
 #include "vdyn/core/analysis.h"
 #include "vdyn/core/plot.h"
 #include "png_image.h"
+#include "test_util.h"
 
 namespace fs = std::filesystem;
 using namespace vdyn;
@@ -27,13 +28,6 @@ using vdyn::test::panelCounts;
 using vdyn::test::readPng;
 
 namespace {
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 fs::path outDir(const std::string& name) {
   const fs::path d = fs::path(VDYN_TEST_OUT_DIR) / "plot" / name;
@@ -84,7 +78,7 @@ TEST(Plot, EveryColumnOnPagesGroupedByPlugin) {
   EXPECT_EQ(fs::path(pngs[2]).filename(), "history_3.png");
   std::multiset<std::string> drawn;
   for (const auto& png : pngs) {
-    const std::string gp = slurp(png + ".gp");
+    const std::string gp = vdyn::test::readTextFile(png + ".gp");
     for (std::size_t c = 1; c < t.columns.size(); ++c)
       if (gp.find("(column(\"" + t.columns[c] + "\"))") != std::string::npos) drawn.insert(t.columns[c]);
   }
@@ -95,7 +89,7 @@ TEST(Plot, EveryColumnOnPagesGroupedByPlugin) {
   EXPECT_EQ(im.height, 3 * 380 + 50);
   const auto n = panelCounts(im, 3, 3);
   for (std::size_t k = 0; k < n.size(); ++k) EXPECT_GT(n[k], 200) << "panel " << k << " of history_2.png";
-  EXPECT_NE(slurp(pngs[1] + ".gp").find("page 2 of 3: tire_lf tire_rf speed_hold"), std::string::npos);
+  EXPECT_NE(vdyn::test::readTextFile(pngs[1] + ".gp").find("page 2 of 3: tire_lf tire_rf speed_hold"), std::string::npos);
 }
 
 // A yaw angle wrapped to +-pi that grows to 4 pi: drawn unwrapped, its curve
@@ -113,7 +107,7 @@ TEST(Plot, WrappedAngleIsDrawnUnwrapped) {
   writeTable(dir, "history", t);
   const auto pngs = renderPlots(dir.string(), {{"history", t}}, {});
   ASSERT_EQ(pngs.size(), 1u);
-  EXPECT_NE(slurp(pngs[0] + ".gp").find("chassis.yaw_rad (unwrapped)"), std::string::npos);
+  EXPECT_NE(vdyn::test::readTextFile(pngs[0] + ".gp").find("chassis.yaw_rad (unwrapped)"), std::string::npos);
   auto bandFigure = [&](bool unwrap) {
     PlotSpec f;
     f.name = unwrap ? "unwrapped_band" : "wrapped_band";
@@ -141,17 +135,17 @@ TEST(Plot, HandlingFiguresOfVdynRun) {
   for (const std::string scene : {"iso7401_bicycle", "iso4138_bicycle"}) {
     const std::string cmd = std::string(VDYN_BIN) + " run " + VDYN_DATA_DIR + "/scenes/" + scene + ".json --out " +
                             (dir / scene).string() + " > " + (dir / (scene + ".log")).string() + " 2>&1";
-    ASSERT_EQ(std::system(cmd.c_str()), 0) << slurp((dir / (scene + ".log")).string());
+    ASSERT_EQ(std::system(cmd.c_str()), 0) << vdyn::test::readTextFile((dir / (scene + ".log")).string());
   }
   const std::string bode = (dir / "iso7401_bicycle" / "frequency_response.png").string();
-  const std::string gp = slurp(bode + ".gp");
+  const std::string gp = vdyn::test::readTextFile(bode + ".gp");
   std::size_t logs = 0;
   for (std::size_t at = gp.find("set logscale x"); at != std::string::npos; at = gp.find("set logscale x", at + 1)) ++logs;
   EXPECT_EQ(logs, 4u);
   EXPECT_NE(gp.find("\"1 Hz\""), std::string::npos);
   for (int n : panelCounts(readPng(bode), 2, 2)) EXPECT_GT(n, 100);
   const std::string iso = (dir / "iso4138_bicycle" / "iso4138.png").string();
-  EXPECT_NE(slurp(iso + ".gp").find("\"limit "), std::string::npos);
+  EXPECT_NE(vdyn::test::readTextFile(iso + ".gp").find("\"limit "), std::string::npos);
   const auto n = panelCounts(readPng(iso), 3, 3);
   for (int k = 0; k < 8; ++k) EXPECT_GT(n[std::size_t(k)], 50) << "panel " << k << " of iso4138.png";
   EXPECT_EQ(n[8], 0);  // the ninth cell of the grid is empty

@@ -17,18 +17,12 @@
 #include <vector>
 
 #include "png_image.h"
+#include "test_util.h"
 #include "vdyn/core/plot.h"
 
 namespace fs = std::filesystem;
 
 namespace {
-
-std::string slurp(const std::string& path) {
-  std::ifstream in(path);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
 
 struct StudyCase {
   std::string study;    ///< program in the build's bin folder
@@ -41,7 +35,7 @@ void PrintTo(const StudyCase& c, std::ostream* os) { *os << c.study; }
 /// Coloured pixels in each drawn panel of `png` (the grid and the number of
 /// panels from its script; a multiplot has a title band of 50 pixels).
 std::vector<int> drawnPanels(const std::string& png) {
-  const std::string gp = slurp(png + ".gp");
+  const std::string gp = vdyn::test::readTextFile(png + ".gp");
   int rows = 1, cols = 1, band = 0;
   std::smatch m;
   if (std::regex_search(gp, m, std::regex("set multiplot layout (\\d+),(\\d+)"))) {
@@ -75,7 +69,7 @@ TEST_P(StudyPlots, EveryPanelOfEveryPngHasItsCurves) {
   const std::string log = (dir / "run.log").string();
   const std::string cmd = "cd '" + std::string(VDYN_DATA_DIR) + "' && '" + VDYN_BIN_DIR + "/" + c.study + "' " +
                           c.options + " --out '" + dir.string() + "' > '" + log + "' 2>&1";
-  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << "\n" << slurp(log);
+  ASSERT_EQ(std::system(cmd.c_str()), 0) << cmd << "\n" << vdyn::test::readTextFile(log);
   int pngs = 0;
   for (const auto& e : fs::recursive_directory_iterator(dir)) {
     if (e.path().extension() != ".png") continue;
