@@ -15,6 +15,7 @@
 // when CMake found Chromium; .ci/test fails when it was not.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <cstring>
@@ -31,9 +32,11 @@
 
 #include "png_image.h"
 #include "test_util.h"
+#include "vdyn/analyses/analyses.h"
 #include "vdyn/core/analysis.h"
 #include "vdyn/core/animation.h"
 #include "vdyn/core/scene_file.h"
+#include "vdyn/handling/iso3888.h"
 #include "vdyn/vehicles/standard_registry.h"
 
 namespace fs = std::filesystem;
@@ -93,14 +96,16 @@ TEST(Animation, GlbPosesEqualTheRunsBodyTransforms) {
   const SimTK::SimbodyMatterSubsystem& matter = scene.getMatter();
   std::vector<double> t_s;
   std::vector<SimTK::Transform> X_GB;  // sample-major, bodies 1..n-1
-  built.scene().setSampleObserver([&](const SimTK::State& s) {
+  const fs::path dir = outDir("poses");
+  TransientSettings settings;
+  settings.t_end_s = 2.0;
+  settings.report_interval_s = 0.01;
+  runTransient(built, settings, {}, [&](const SimTK::State& s) {
     animation.sample(s);
     t_s.push_back(s.getTime());
     for (SimTK::MobilizedBodyIndex b(1); b < matter.getNumBodies(); ++b)
       X_GB.push_back(matter.getMobilizedBody(b).getBodyTransform(s));
   });
-  const fs::path dir = outDir("poses");
-  const AnalysisResult r = built.analysis->run({desc, built, dir.string(), {}});
   const std::size_t nb = std::size_t(matter.getNumBodies() - 1);
   ASSERT_EQ(t_s.size(), 201u);  // 0 .. 2 s every 0.01 s
   ASSERT_EQ(animation.bodyNames().size(), nb);
@@ -210,6 +215,74 @@ TEST(Animation, VdynRunWritesGlbAndViewer) {
       path = true;
     }
   EXPECT_TRUE(path);
+}
+
+// ISO 3888-2 with --animation: the highest passing run (the analysis runs it
+// once more, recorded): the chassis poses in the .glb equal that run's own
+// samples (iso3888_best: x, y, yaw of the chassis) at three times; the cones
+// of the course stand where calcConePositions puts them, tangent to each
+// lane's limits from outside, equally spaced at most 3 m apart.
+TEST(Animation, Iso3888ShowsTheHighestPassingRunAndItsCones) {
+  PluginRegistry& registry = standardRegistry();
+  const SceneDescription desc = SceneDescription::fromFile(
+      "scenes/iso3888_bicycle.json", registry,
+      {Override::parse("analysis.speed_low_m_s=10"), Override::parse("analysis.speed_high_m_s=16"),
+       Override::parse("analysis.speed_tolerance_m_s=1")});
+  RunOptions options;
+  options.out_dir = outDir("iso3888").string();
+  options.plots = false;
+  options.animation = true;
+  const SceneRun run = runSceneWithTables(desc, options);
+  const Table* best = nullptr;
+  for (const auto& [name, t] : run.tables)
+    if (name == "iso3888_best") best = &t;
+  ASSERT_NE(best, nullptr);
+  auto col = [&](const std::string& c) {
+    const auto it = std::find(best->columns.begin(), best->columns.end(), c);
+    EXPECT_NE(it, best->columns.end()) << c;
+    return std::size_t(it - best->columns.begin());
+  };
+  const std::size_t ct = col("t_s"), cx = col("x_m"), cy = col("y_m"), cyaw = col("yaw_deg");
+  const tinygltf::Model m = loadGlb((fs::path(options.out_dir) / "animation.glb").string());
+  const tinygltf::Value& vd = m.asset.extras.Get("vdyn");
+  const std::size_t n = std::size_t(vd.Get("samples").GetNumberAsInt()), nb = vd.Get("bodies").ArrayLen();
+  ASSERT_EQ(n, best->rows.size());
+  EXPECT_EQ(vd.Get("bodies").Get(0).Get<std::string>(), "chassis");
+  const std::vector<double> t64 = doubles(m, vd.Get("time_s_f64_bufferView").GetNumberAsInt());
+  const std::vector<double> X64 = doubles(m, vd.Get("X_GB_f64_bufferView").GetNumberAsInt());
+  for (const std::size_t k : {n / 4, n / 2, n - 1}) {
+    const std::vector<double>& row = best->rows[k];
+    EXPECT_NEAR(t64[k], row[ct], 1e-9);
+    const double* g = &X64[k * nb * 12];
+    EXPECT_NEAR(g[0], row[cx], 1e-9) << "chassis x at t " << row[ct];
+    EXPECT_NEAR(g[1], row[cy], 1e-9) << "chassis y at t " << row[ct];
+    // yaw from R_GB (row-major): atan2(R10, R00) (the single-track chassis moves in the plane).
+    EXPECT_NEAR(std::atan2(g[3 + 3], g[3 + 0]), row[cyaw] * M_PI / 180, 1e-9) << "chassis yaw at t " << row[ct];
+  }
+  const Json& sum = run.summary;
+  const Iso3888Layout course = Iso3888Layout::make(sum.at("vehicle_width_m").get<double>(),
+                                                   sum.at("lanes").at(0).at("x_start_m").get<double>());
+  EXPECT_GT(X64[(n - 1) * nb * 12], course.endX());  // past section 5's end
+
+  // The cones: nodes "cone<i>" at calcConePositions' points.
+  const std::vector<SimTK::Vec3> cones = calcConePositions(course, 0.15);
+  // 12 m, 11 m, 12 m lanes at most 3 m apart: 5, 5, 5 cones per line, two lines each.
+  ASSERT_EQ(cones.size(), 30u);
+  std::size_t found = 0;
+  for (const auto& node : m.nodes) {
+    if (node.name.rfind("cone", 0) != 0) continue;
+    const std::size_t i = std::stoul(node.name.substr(4));
+    ASSERT_LT(i, cones.size());
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(node.translation.at(j), cones[i][j], 1e-12) << node.name;
+    ++found;
+  }
+  EXPECT_EQ(found, cones.size());
+  // Tangent from outside: section 1's first left cone 0.15 m left of its left limit.
+  EXPECT_NEAR(cones[0][1], course.lanes[0].y_left_m + 0.15, 1e-12);
+  EXPECT_NEAR(cones[5][1], course.lanes[0].y_right_m - 0.15, 1e-12);
+  EXPECT_NEAR(cones[4][0] - cones[0][0], 12.0, 1e-12);
+  const auto anim = run.summary.at("animation");
+  EXPECT_EQ(anim.size(), 2u);
 }
 
 // An analysis that does not run its scene through a Recorder has no animation: a named error.

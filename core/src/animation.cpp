@@ -437,7 +437,13 @@ function main(THREE) {
 
 }  // namespace
 
-AnimationRecorder::AnimationRecorder(const Scene& scene) {
+void AnimationRecorder::restart(const Scene& scene) {
+  bodies_.clear();
+  names_.clear();
+  shapes_.clear();
+  decorations_ = SceneDecorations();
+  time_s_.clear();
+  poses_.clear();
   const SimTK::SimbodyMatterSubsystem& matter = scene.getMatter();
   std::map<int, std::string> named;  // mobilized body index -> first name (a body may have two)
   for (const auto& n : scene.getBodyNames()) named.emplace(int(scene.getBody(n).getMobilizedBodyIndex()), n);
@@ -511,7 +517,7 @@ std::string AnimationRecorder::makeGlb() const {
   }
   if (!decorations_.cones_G.empty()) {
     AnimationShape cone;
-    cone.size_m = {0.15, 0.5, 0};  // base radius, height, m
+    cone.size_m = {decorations_.cone_base_radius_m, decorations_.cone_height_m, 0};  // base radius, height, m
     const int mesh = g.triangles("cone", roundMesh(cone, true), g.material("cone", {1.0, 0.45, 0.0}));
     for (std::size_t i = 0; i < decorations_.cones_G.size(); ++i) {
       const int node = g.node("cone" + std::to_string(i), mesh);

@@ -5,13 +5,12 @@
 
 namespace vdyn {
 
-Recorder::Recorder(const Scene& scene, std::vector<std::string> names)
-    : scene_(scene), names_(std::move(names)) {
+Recorder::Recorder(const Scene& scene, std::vector<std::string> names, SampleObserver observer)
+    : scene_(scene), names_(std::move(names)), observer_(std::move(observer)) {
   for (const auto& n : names_) {
     outputs_.push_back(&scene_.getOutput(n));
     if (outputs_.back()->stage > stage_) stage_ = outputs_.back()->stage;
   }
-  observer_ = scene_.getSampleObserver();
   if (observer_ && stage_ < SimTK::Stage::Position) stage_ = SimTK::Stage::Position;  // it reads X_GB
   columns_.resize(names_.size());
 }

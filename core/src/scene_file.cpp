@@ -433,14 +433,12 @@ SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& opt
     std::filesystem::create_directories(options.out_dir, ec);
     if (ec) throw Error("cannot create output folder '" + options.out_dir + "': " + ec.message());
   }
-  const AnalysisContext ctx{scene, built, options.out_dir, options.progress};
   std::unique_ptr<AnimationRecorder> animation;
   if (options.animation) {
     if (options.out_dir.empty()) throw Error("--animation: no output folder to write animation.glb into");
     animation = std::make_unique<AnimationRecorder>(built.scene());
-    AnimationRecorder* rec = animation.get();
-    built.scene().setSampleObserver([rec](const SimTK::State& s) { rec->sample(s); });
   }
+  const AnalysisContext ctx{scene, built, options.out_dir, options.progress, animation.get()};
   AnalysisResult r = built.analysis->run(ctx);
   Json summary = {{"scene", scene.name()}, {"analysis", built.analysis->type()}};
   for (auto it = r.summary.begin(); it != r.summary.end(); ++it) summary[it.key()] = it.value();
@@ -448,7 +446,7 @@ SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& opt
     if (animation->size() < 2)
       throw Error("--animation: scene '" + scene.name() + "': analysis '" + built.analysis->type() +
                   "' sampled no time history of its scene (" + std::to_string(animation->size()) +
-                  " samples; an animation needs a transient analysis with report_interval_s > 0)");
+                  " samples; an animation needs a transient analysis with report_interval_s > 0, or iso3888_2)");
     Json files = Json::array();
     for (const auto& f : writeAnimation(*animation, options.out_dir + "/animation", scene.name()))
       files.push_back(std::filesystem::path(f).filename().string());

@@ -310,6 +310,16 @@ class Iso3888Analysis : public Analysis {
     const VehicleFootprint fp = calcVehicleFootprint(*ctx.built.vehicle, tire_width_m_);
     const Iso3888Result r = findHighestPassingSpeed(ctx.description, s_, fp);
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    if (ctx.animation) {
+      // vdyn run --animation: the highest passing run once more, recorded
+      // (the bisection's runs record nothing). A run is deterministic: the
+      // same samples, or the animation would show another run than reported.
+      const Iso3888Run& best = r.runs.at(r.best_run);
+      const Iso3888Run again = runIso3888(ctx.description, s_, r.layout, r.body, best.speed_m_s, ctx.animation);
+      if (again.x_m != best.x_m || again.y_m != best.y_m || again.yaw_rad != best.yaw_rad)
+        throw Error(ctx.description.path() + ": ISO 3888-2 --animation: the run at " + formatValue(best.speed_m_s) +
+                    " m/s repeated gave other samples than the reported one");
+    }
     AnalysisResult res;
     Table runs;
     runs.columns = {"speed_m_s", "speed_km_h", "completed", "pass", "cone_lines_struck", "min_clearance_m",

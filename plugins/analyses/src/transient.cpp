@@ -1,6 +1,7 @@
 #include <cmath>
 
 #include "vdyn/analyses/analyses.h"
+#include "vdyn/core/animation.h"
 
 namespace vdyn {
 
@@ -36,7 +37,8 @@ SimulationSettings TransientSettings::simulation() const {
   return s;
 }
 
-TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, const ProgressFactory& progress) {
+TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, const ProgressFactory& progress,
+                          const SampleObserver& observer) {
   requirePositive(settings.t_end_s, "transient t_end_s");
   Scene& scene = built.scene();
   std::vector<IntegralHandle> handles;
@@ -47,8 +49,8 @@ TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, 
   // initial state contradicts, e.g. a speed hold at another speed.
   for (const auto& p : built.scene().getPlugins()) p->checkInitialState(built.scene(), r.final_state);
   r.vehicle = built.vehicle->describe(r.final_state);
-  // A scene with a sample observer (vdyn run --animation) is sampled even with no outputs.
-  if (!built.outputs.empty() || scene.getSampleObserver()) r.recorder = std::make_unique<Recorder>(scene, built.outputs);
+  // With an observer (vdyn run --animation) the run is sampled even with no outputs.
+  if (!built.outputs.empty() || observer) r.recorder = std::make_unique<Recorder>(scene, built.outputs, observer);
   SimulationSettings sim = settings.simulation();
   for (const auto& p : scene.getPlugins())
     for (double t : p->calcInputJumpTimes()) sim.restart_times_s.push_back(t);
@@ -139,7 +141,7 @@ class TransientAnalysis : public Analysis {
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
     TransientRun run;
     try {
-      run = runTransient(ctx.built, s_, ctx.progress);
+      run = runTransient(ctx.built, s_, ctx.progress, ctx.animation ? ctx.animation->observer() : SampleObserver{});
     } catch (const RunStopped& e) {
       throw Error(std::string(e.what()) + " (an event kind listed in analysis.events.fatal)");
     }

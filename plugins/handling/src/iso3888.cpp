@@ -5,6 +5,7 @@
 #include <cmath>
 #include <fstream>
 
+#include "vdyn/core/animation.h"
 #include "vdyn/core/file_io.h"
 #include "vdyn/core/recorder.h"
 #include "vdyn/handling/handling.h"
@@ -215,8 +216,21 @@ double maxAbs(const std::vector<double>& v) {
 }
 }  // namespace
 
+std::vector<SimTK::Vec3> calcConePositions(const Iso3888Layout& L, double r, double spacing) {
+  requireNonNegative(r, "ISO 3888-2 cone base radius");
+  requirePositive(spacing, "ISO 3888-2 cone spacing");
+  std::vector<SimTK::Vec3> p_G;
+  for (const ConeLane& lane : L.lanes) {
+    const double len = lane.x_end_m - lane.x_start_m;
+    const int gaps = std::max(1, int(std::ceil(len / spacing - 1e-9)));
+    for (const double y : {lane.y_left_m + r, lane.y_right_m - r})
+      for (int k = 0; k <= gaps; ++k) p_G.push_back({lane.x_start_m + len * k / gaps, y, 0.0});
+  }
+  return p_G;
+}
+
 Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, const Iso3888Layout& L,
-                      const BodyOutline& body, double U) {
+                      const BodyOutline& body, double U, AnimationRecorder* animation) {
   requirePositive(U, "ISO 3888-2 entry speed");
   // The scene's plugins the run reads, from the built scene (typed access):
   // the path controller and the steering it drives, the rear-steer
@@ -254,7 +268,14 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
                                      dist, set.path_controller + ".lateral_acceleration_m_s2"};
     if (!frontSteer.empty()) cols.push_back(frontSteer + ".angle_rad");
     if (!rearSteer.empty()) cols.push_back(rearSteer + ".angle_rad");
-    Recorder rec(scene, cols);
+    SampleObserver observer;
+    if (animation) {
+      animation->restart(scene);
+      SceneDecorations& d = animation->updDecorations();
+      d.cones_G = calcConePositions(L, d.cone_base_radius_m);
+      observer = animation->observer();
+    }
+    Recorder rec(scene, cols, observer);
     SimulationSettings sim;
     // To lead_out_m past section 5 at the entry speed, with time to spare for
     // the speed coasting loses (reached_exit checks the body left the course).

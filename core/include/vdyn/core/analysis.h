@@ -21,6 +21,7 @@ namespace vdyn {
 
 class SceneDescription;
 struct BuiltScene;
+class AnimationRecorder;
 
 /// A table: named columns of numbers (written as CSV with a header row).
 struct Table {
@@ -95,6 +96,11 @@ struct AnalysisContext {
   std::string out_dir;
   /// Progress of long runs (empty = none).
   ProgressFactory progress;
+  /// `vdyn run --animation`: the recorder of the run the analysis reports
+  /// (its Recorder gets animation->observer(); an analysis that builds its own
+  /// scene for that run calls animation->restart(scene) first). Null: none
+  /// asked, and an analysis records nothing for it.
+  AnimationRecorder* animation = nullptr;
 };
 
 class Analysis {

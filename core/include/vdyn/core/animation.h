@@ -3,8 +3,9 @@
 // scene drawn as a simple shape from its mass properties, its pose X_GB
 // sampled at the run's report times, written as a glTF 2.0 binary (.glb) and
 // a self-contained HTML viewer (three.js and the .glb inlined). Recording
-// costs nothing unless asked: the recorder is the scene's sample observer
-// (Scene::setSampleObserver), which Recorder calls at each of its samples.
+// costs nothing unless asked: `vdyn run --animation` hands an analysis an
+// AnimationRecorder (AnalysisContext::animation), and the analysis gives the
+// recorder's observer() to the Recorder of the run it reports.
 //
 // The .glb: a root node "ground" turns Simbody's z-up ground frame G into
 // glTF's y-up; under it one node per body (its TRS is X_GB: translation p_GB,
@@ -21,6 +22,7 @@
 #include <Simbody.h>
 
 #include "vdyn/core/plugin.h"
+#include "vdyn/core/recorder.h"
 
 namespace vdyn {
 
@@ -44,12 +46,23 @@ class AnimationRecorder {
   /// says nothing of its shape, an arm's): a thin link between the farthest of
   /// its joints (mobilizer frames) and mass centre. The plugins' decorations
   /// are collected here.
-  explicit AnimationRecorder(const Scene& scene);
+  explicit AnimationRecorder(const Scene& scene) { restart(scene); }
+
+  /// Starts afresh on `scene` (bodies, shapes and decorations read from it,
+  /// no samples): an analysis that builds its own scene for the run it
+  /// reports (ISO 3888-2 at its highest passing speed) records that one. The
+  /// scene must outlive the recording's samples.
+  void restart(const Scene& scene);
 
   /// Records X_GB of every body; `state` realized through Stage::Position.
   /// A sample at a time not after the last one starts the recording afresh
   /// (an analysis that runs the scene again: the animation shows its last run).
   void sample(const SimTK::State& state);
+
+  /// The observer a Recorder calls at each sample: sample(state).
+  SampleObserver observer() {
+    return [this](const SimTK::State& state) { sample(state); };
+  }
 
   std::size_t size() const { return time_s_.size(); }
   const std::vector<double>& time() const { return time_s_; }
@@ -58,6 +71,9 @@ class AnimationRecorder {
   /// X_GB of body b at sample k.
   const SimTK::Transform& pose(std::size_t k, std::size_t b) const { return poses_[k * names_.size() + b]; }
   const SceneDecorations& decorations() const { return decorations_; }
+  /// An analysis adds what it shows besides the plugins' decorations (ISO
+  /// 3888-2: its cones) after restart().
+  SceneDecorations& updDecorations() { return decorations_; }
 
   /// The .glb file's bytes. Throws Error if nothing was recorded.
   std::string makeGlb() const;

@@ -30,6 +30,8 @@ struct SceneDecorations {
   };
   std::vector<Line> lines;
   std::vector<SimTK::Vec3> cones_G;  ///< cone base centres in G, m
+  double cone_base_radius_m = 0.15;  ///< every cone's base radius, m
+  double cone_height_m = 0.5;        ///< every cone's height, m (ISO 3888-2 4.2: at least 0.5 m)
 };
 
 class Plugin {

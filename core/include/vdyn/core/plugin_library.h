@@ -28,9 +28,11 @@
 /// may add to; WheeledVehicle for FourWsVehicle. 5: Suspension::usesRack/setRack
 /// (the rack and pinion), SteeringPlugin's rack members, Plugin::calcInputJumpTimes
 /// and SteeringCommand::getRateJumpTimes. 6: Plugin::addDecorations (animations),
-/// Scene's sample observer. A library must return the value it was
-/// compiled with from vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 6
+/// Scene's sample observer. 7: the sample observer moved from Scene to
+/// Recorder's constructor (AnalysisContext::animation), SceneDecorations'
+/// cone size. A library must return the value it was compiled with from
+/// vdyn_plugin_abi_version().
+#define VDYN_PLUGIN_ABI_VERSION 7
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))

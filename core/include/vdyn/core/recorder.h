@@ -3,6 +3,7 @@
 // integrator's interpolant (recordInterpolated) or its interpolated states, so
 // reporting never forces an integrator step, copies no State per sample and
 // projects nothing.
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -10,10 +11,16 @@
 
 namespace vdyn {
 
+/// Called with each sample's state, realized through Stage::Position (an
+/// animation's recorder, vdyn/core/animation.h).
+using SampleObserver = std::function<void(const SimTK::State&)>;
+
 class Recorder {
  public:
-  /// Records time plus the named outputs (each must exist in the scene).
-  Recorder(const Scene& scene, std::vector<std::string> outputNames);
+  /// Records time plus the named outputs (each must exist in the scene), and
+  /// hands each sample's state to `observer` if one is given (the state is
+  /// then realized through Stage::Position at least).
+  Recorder(const Scene& scene, std::vector<std::string> outputNames, SampleObserver observer = {});
 
   /// Evaluates the outputs on `state`. If `state` is not realized far enough (the
   /// integrator's state is const), its t, q, u, z are copied into a workspace
@@ -46,7 +53,7 @@ class Recorder {
   std::vector<std::string> names_;
   std::vector<const Output*> outputs_;
   SimTK::Stage stage_ = SimTK::Stage::Time;
-  Scene::SampleObserver observer_;  ///< the scene's sample observer when this recorder was made
+  SampleObserver observer_;
   /// The workspace's discrete part is that of `like` (copies it if not).
   void syncWorkspace(const SimTK::State& like);
   SimTK::State work_;

@@ -64,14 +64,6 @@ class Scene {
   /// The named bodies' names, sorted.
   std::vector<std::string> getBodyNames() const;
 
-  // --- sample observer (an animation's recorder) -----------------------------
-  /// Called by every Recorder of this scene at each of its samples with the
-  /// sampled state realized through Stage::Position (Recorder realizes that far
-  /// when an observer is set). Empty (the default): nothing extra is done.
-  using SampleObserver = std::function<void(const SimTK::State&)>;
-  void setSampleObserver(SampleObserver observer) { sampleObserver_ = std::move(observer); }
-  const SampleObserver& getSampleObserver() const { return sampleObserver_; }
-
   // --- services (e.g. the road) shared by plugins ---------------------------
   template <class T>
   void setService(const std::string& name, std::shared_ptr<T> service) {
@@ -130,7 +122,6 @@ class Scene {
   SimTK::SimbodyMatterSubsystem matter_;
   SimTK::GeneralForceSubsystem forces_;
   std::map<std::string, SimTK::MobilizedBody> bodies_;
-  SampleObserver sampleObserver_;
   std::map<std::string, std::shared_ptr<const void>> services_;
   std::map<std::string, const std::type_info*> serviceTypes_;
   std::vector<std::unique_ptr<Plugin>> plugins_;

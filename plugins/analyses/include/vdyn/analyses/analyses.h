@@ -55,9 +55,11 @@ struct TransientRun {
 };
 
 /// Runs the built scene from its initial state to settings.t_end_s, recording
-/// `built.outputs`. `progress` may be empty. The one transient run the
+/// `built.outputs`. `progress` may be empty; `observer`, if given, gets each
+/// sample's state (an animation's recorder). The one transient run the
 /// transient analysis and the chapter programs share.
-TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, const ProgressFactory& progress = {});
+TransientRun runTransient(BuiltScene& built, const TransientSettings& settings, const ProgressFactory& progress = {},
+                          const SampleObserver& observer = {});
 
 /// The transient analysis's summary of a run: "final" (every scene output at
 /// the end), "peak_abs" (largest |value| of each recorded output), "rms" (root

@@ -48,6 +48,8 @@
 
 namespace vdyn {
 
+class AnimationRecorder;
+
 /// One lane section with cones: [x_start, x_end] between cone lines at y_right < y_left.
 struct ConeLane {
   int section = 0;            ///< 1, 3 or 5
@@ -162,9 +164,20 @@ struct Iso3888Run {
   void writeCsv(const std::string& path) const;
 };
 
-/// Runs the scene (closed loop) through the course at one entry speed.
+/// Runs the scene (closed loop) through the course at one entry speed. With
+/// `animation` (vdyn run --animation), the run's scene is recorded into it
+/// (restarted on that scene), with the course's cones as decorations.
 Iso3888Run runIso3888(const SceneDescription& scene, const Iso3888Settings& settings, const Iso3888Layout& layout,
-                      const BodyOutline& body, double speed_m_s);
+                      const BodyOutline& body, double speed_m_s, AnimationRecorder* animation = nullptr);
+
+/// The cones of the course as an animation shows them: along both limits of
+/// each coned lane (sections 1, 3, 5), from its start to its end at most
+/// `max_spacing_m` apart (equally spaced, both ends included), each base
+/// circle tangent to the limit from outside (its centre `cone_base_radius_m`
+/// beyond the line), on the ground (z = 0). Section 1's left cones first,
+/// then its right ones, then sections 3 and 5 alike.
+std::vector<SimTK::Vec3> calcConePositions(const Iso3888Layout& layout, double cone_base_radius_m,
+                                           double max_spacing_m = 3.0);
 
 struct Iso3888Result {
   Iso3888Layout layout;
