@@ -502,7 +502,12 @@ TEST(SineWithDwell, LinearTireBicycleMatchesItsLinearisedEquations) {
   set.first_factor = 1.5;
   set.max_amplitude_factor = 1.5;  // one run
   set.integrator.accuracy = 1e-8;
-  const SineWithDwellResult r = runSineWithDwell(v, set);
+  const SineWithDwellResult r = runSineWithDwell(
+      [] {
+        std::shared_ptr<HandlingScene> own = bike("linear");
+        return std::shared_ptr<const HandlingVehicle>(own, &own->vehicle);
+      },
+      set);
   ASSERT_EQ(r.runs.size(), 1u);
   const SineWithDwellRun& run = r.runs[0];
   ASSERT_TRUE(run.completed) << run.reason;

@@ -877,4 +877,26 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
   return res;
 }
 
+int hardwareThreads() { return int(std::max(1u, std::thread::hardware_concurrency())); }
+
+JobsTiming runJobs(std::size_t n, int threads, const std::function<void(std::size_t)>& job) {
+  if (threads < 1) throw Error("runJobs: threads must be at least 1, got " + std::to_string(threads));
+  SweepDescription d;
+  d.name = "jobs";
+  d.variations.resize(n);
+  for (std::size_t i = 0; i < n; ++i) d.variations[i].index = i;
+  SweepOptions o;
+  o.threads = threads;
+  const SweepResult r = runSweep(
+      d,
+      [&job](const SweepDescription&, const Variation& v) {
+        job(v.index);
+        return Json::object();
+      },
+      o);
+  for (const SweepRow& row : r.rows)
+    if (!row.ok) throw Error(row.reason);
+  return {r.wall_s, r.cpu_s, r.workers};
+}
+
 }  // namespace vdyn

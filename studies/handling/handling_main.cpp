@@ -6,13 +6,16 @@
 // PNG plots, summary.json, printed tables and the 2WS/4WS ranking.
 #include "vdyn/core/text.h"
 #include <algorithm>
+#include <chrono>
 #include <cmath>
+#include <functional>
 #include <cstdio>
 #include <fstream>
 #include <sstream>
 
 #include "study.h"
 #include "vdyn/core/scene_file.h"
+#include "vdyn/core/sweep.h"
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/handling/iso4138.h"
 #include "vdyn/handling/iso7401.h"
@@ -55,15 +58,24 @@ std::string fileTag(const std::string& vehicle) {
   return t;
 }
 
-Json iso4138(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
+/// ISO 4138 at one radius (one job).
+ConstantRadiusResult runIso4138(const Config& c, const std::string& vehicle, double R) {
+  auto b = build(c, vehicle);
+  ConstantRadiusSettings set = ConstantRadiusSettings::fromParams(c.data.child("iso4138"));
+  set.radius_m = R;
+  return runConstantRadius(b->vehicle, set);
+}
+
+/// ISO 4138's files, summary and lines from the radii's results (in radii_m order).
+Json iso4138(const Config& c, const std::string& vehicle, const std::vector<ConstantRadiusResult>& results,
+             const std::string& out, bool plots) {
   Json j = Json::array();
   const ParamReader p = c.data.child("iso4138");
   std::vector<study::Series> sd, sb, sr, sk, hd;
-  for (double R : p.numbers("radii_m")) {
-    auto b = build(c, vehicle);
-    ConstantRadiusSettings set = ConstantRadiusSettings::fromParams(p);
-    set.radius_m = R;
-    const ConstantRadiusResult r = runConstantRadius(b->vehicle, set);
+  const std::vector<double> radii = p.numbers("radii_m");
+  for (std::size_t ri = 0; ri < radii.size(); ++ri) {
+    const double R = radii[ri];
+    const ConstantRadiusResult& r = results.at(ri);
     const std::string csv = out + "/iso4138_" + fileTag(vehicle) + "_R" + formatValue(R) + ".csv";
     OutputFile f(csv);
     f << "speed_m_s,lateral_accel_m_s2,front_deg,rear_deg,side_slip_deg,roll_deg,yaw_rate_rad_s,"
@@ -137,17 +149,53 @@ Json iso4138(const Config& c, const std::string& vehicle, const std::string& out
   return j;
 }
 
-Json iso7401(const Config& c, const std::string& vehicle, const std::string& out, bool plots, bool check) {
+/// ISO 7401's step steer and linear frequency response (one job), the
+/// response at 1 Hz (from the sweep if it holds 1 Hz).
+struct Iso7401Run {
+  StepSteerResult step;
+  FrequencyResponseResult fr;
+  FrequencyResponsePoint at1;
+};
+Iso7401Run runIso7401(const Config& c, const std::string& vehicle) {
   const ParamReader p = c.data.child("iso7401");
   auto b = build(c, vehicle);
   const StepSteerSettings set = StepSteerSettings::fromParams(p);
-  const StepSteerResult st = runStepSteer(b->vehicle, set);
+  Iso7401Run r;
+  r.step = runStepSteer(b->vehicle, set);
+  r.fr = calcSteeringFrequencyResponse(
+      b->vehicle, set.speed_m_s,
+      logFrequencies(p.number("frequency_from_Hz"), p.number("frequency_to_Hz"), p.integer("frequency_count")));
+  bool have = false;
+  for (const auto& q : r.fr.points)
+    if (!have && std::abs(q.frequency_Hz - 1.0) < 1e-9) r.at1 = q, have = true;
+  if (!have) r.at1 = calcSteeringFrequencyResponse(b->vehicle, set.speed_m_s, {1.0}).points.at(0);
+  return r;
+}
+
+/// ISO 7401's check at one frequency (one job): the sine-steer simulation and the linear response.
+struct SineCheck {
+  SineSteerResult sim;
+  FrequencyResponsePoint lin;
+};
+SineCheck runSineCheck(const Config& c, const std::string& vehicle, double f) {
+  const ParamReader p = c.data.child("iso7401");
+  auto b = build(c, vehicle);
+  const StepSteerSettings set = StepSteerSettings::fromParams(p);
+  SineCheck k;
+  k.sim = runSineSteer(b->vehicle, set.speed_m_s, f, p.number("check_amplitude_rad"), set.integrator);
+  k.lin = calcSteeringFrequencyResponse(b->vehicle, set.speed_m_s, {f}).points.at(0);
+  return k;
+}
+
+Json iso7401(const Config& c, const std::string& vehicle, const Iso7401Run& run, const std::vector<SineCheck>& checks,
+             const std::string& out, bool plots, bool check) {
+  const ParamReader p = c.data.child("iso7401");
+  const StepSteerSettings set = StepSteerSettings::fromParams(p);
+  const StepSteerResult& st = run.step;
   const std::string t = fileTag(vehicle);
   const std::string stepCsv = out + "/iso7401_step_" + t + ".csv";
   st.history.writeCsv(stepCsv);
-  const FrequencyResponseResult fr = calcSteeringFrequencyResponse(
-      b->vehicle, set.speed_m_s,
-      logFrequencies(p.number("frequency_from_Hz"), p.number("frequency_to_Hz"), p.integer("frequency_count")));
+  const FrequencyResponseResult& fr = run.fr;
   const std::string frCsv = out + "/iso7401_frequency_" + t + ".csv";
   {
     OutputFile f(frCsv);
@@ -183,12 +231,7 @@ Json iso7401(const Config& c, const std::string& vehicle, const std::string& out
     if (q.yaw_gain_1_per_s > gPeak) gPeak = q.yaw_gain_1_per_s, fPeak = q.frequency_Hz;
   j["yaw_gain_peak_frequency_Hz"] = fPeak;
   j["yaw_gain_peak_over_steady"] = gPeak / fr.yaw_gain_zero_1_per_s;
-  auto frAt = [&](double f) {
-    for (const auto& q : fr.points)
-      if (std::abs(q.frequency_Hz - f) < 1e-9) return q;
-    return calcSteeringFrequencyResponse(b->vehicle, set.speed_m_s, {f}).points.at(0);
-  };
-  const FrequencyResponsePoint at1 = frAt(1.0);
+  const FrequencyResponsePoint& at1 = run.at1;
   j["yaw_phase_at_1Hz_deg"] = at1.yaw_phase_deg;
   j["ay_phase_at_1Hz_deg"] = at1.ay_phase_deg;
   std::printf("  ISO 7401 %-14s step to %s deg: r/delta %s 1/s, response time %s s, peak response time %s, overshoot "
@@ -202,10 +245,11 @@ Json iso7401(const Config& c, const std::string& vehicle, const std::string& out
               sig(gPeak / fr.yaw_gain_zero_1_per_s, 3).c_str(), sig(fPeak, 3).c_str());
   if (check) {
     Json cj = Json::array();
-    IntegratorSettings integ = set.integrator;
-    for (double f : p.numbers("check_frequencies_Hz")) {
-      const SineSteerResult s = runSineSteer(b->vehicle, set.speed_m_s, f, p.number("check_amplitude_rad"), integ);
-      const FrequencyResponsePoint l = calcSteeringFrequencyResponse(b->vehicle, set.speed_m_s, {f}).points.at(0);
+    const std::vector<double> freqs = p.numbers("check_frequencies_Hz");
+    for (std::size_t fi = 0; fi < freqs.size(); ++fi) {
+      const double f = freqs[fi];
+      const SineSteerResult& s = checks.at(fi).sim;
+      const FrequencyResponsePoint& l = checks.at(fi).lin;
       auto rel = [](double a, double b) { return std::abs(a - b) / std::abs(b); };
       cj.push_back({{"frequency_Hz", f},
                     {"sim_yaw_gain", s.yaw_gain_1_per_s},
@@ -241,10 +285,9 @@ Json iso7401(const Config& c, const std::string& vehicle, const std::string& out
   return j;
 }
 
-Json sineWithDwell(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
-  auto b = build(c, vehicle);
+Json sineWithDwell(const Config& c, const std::string& vehicle, const SineWithDwellResult& r, const std::string& out,
+                   bool plots) {
   const SineWithDwellSettings set = SineWithDwellSettings::fromParams(c.data.child("sine_with_dwell"));
-  const SineWithDwellResult r = runSineWithDwell(b->vehicle, set);
   const std::string t = fileTag(vehicle);
   Json runs = Json::array();
   std::vector<study::Series> ser;
@@ -306,7 +349,14 @@ Json sineWithDwell(const Config& c, const std::string& vehicle, const std::strin
           {"max_yaw_ratio_1_75s", orNull(completed > 0, worst175)},
           {"min_lateral_displacement_m", orNull(completedFrom5 > 0, minDisp)}};
 }
-Json iso3888(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
+/// ISO 3888-2 (one job: its search's rounds are sequential): the scene run as
+/// `vdyn run` does (its files in <out>/iso3888_<vehicle>/); its summary, and
+/// the integrator steps of its runs.
+struct Iso3888Job {
+  Json summary;
+  long steps = 0;
+};
+Iso3888Job runIso3888Scene(const Config& c, const std::string& vehicle, const std::string& out, bool plots) {
   const ParamReader p = c.data.child("iso3888");
   const bool bike = vehicle == "bicycle";
   std::vector<Override> ov;
@@ -316,7 +366,19 @@ Json iso3888(const Config& c, const std::string& vehicle, const std::string& out
   RunOptions opt;
   opt.out_dir = out + "/iso3888_" + fileTag(vehicle);
   opt.plots = plots;
-  const Json s = runScene(scene, opt);
+  const SceneRun run = runSceneWithTables(scene, opt);
+  Iso3888Job j;
+  j.summary = run.summary;
+  for (const auto& [name, table] : run.tables) {
+    if (name != "iso3888_runs") continue;
+    const std::size_t col = std::find(table.columns.begin(), table.columns.end(), "steps") - table.columns.begin();
+    for (const auto& row : table.rows) j.steps += long(row.at(col));
+  }
+  return j;
+}
+
+Json iso3888(const std::string& vehicle, const Iso3888Job& job, const std::string& out) {
+  const Json& s = job.summary;
   auto numOr = [](const Json& j) { return j.is_number() ? j.get<double>() : std::nan(""); };
   std::printf("  ISO 3888-2 %-12s highest passing entry speed %s m/s (%s km/h), lowest failing %s m/s, %zu runs, "
               "min clearance %s m, %s s\n",
@@ -325,7 +387,7 @@ Json iso3888(const Config& c, const std::string& vehicle, const std::string& out
               sig(numOr(s["wall_time_s"]), 3).c_str());
   return {{"highest_pass_m_s", s["highest_pass_m_s"]}, {"lowest_fail_m_s", s["lowest_fail_m_s"]},
           {"top_of_bracket_passes", s["top_of_bracket_passes"]}, {"bracket_m_s", s["bracket_m_s"]},
-          {"tolerance_m_s", s["tolerance_m_s"]}, {"runs", s["runs"].size()}, {"out_dir", opt.out_dir}};
+          {"tolerance_m_s", s["tolerance_m_s"]}, {"runs", s["runs"].size()}, {"out_dir", out + "/iso3888_" + fileTag(vehicle)}};
 }
 
 /// The 2WS / 4WS table: one row per vehicle run, the App. A strategies ranked
@@ -335,7 +397,7 @@ Json iso3888(const Config& c, const std::string& vehicle, const std::string& out
 /// limit a_y at R = 100 m (higher), ISO 7401 yaw response time (shorter), SWD
 /// (pass; else the higher first failing amplitude), ISO 3888-2 highest passing
 /// entry speed (higher). The bicycle, if run, is listed unranked.
-void printRanking(const Json& summary, const std::vector<std::string>& vehicles) {
+void printRanking(const Json& summary, const std::vector<std::string>& vehicles, const std::string& csvPath) {
   struct Row {
     std::string name;
     double ay = NAN, k0 = NAN, lost = NAN, tr = NAN, tpk = NAN, os = NAN, swdScore = NAN, r1 = NAN, dlc = NAN;
@@ -406,9 +468,20 @@ void printRanking(const Json& summary, const std::vector<std::string>& vehicles)
   std::printf("  %-4s %-14s | %-16s %-9s %-10s | %-12s %-10s %-9s | %-18s %-8s | %-14s\n", "rank", "vehicle",
               "4138 ay_lim m/s2", "K0 d/mps2", "unstable", "7401 t_r90 s", "t_peak s", "overshoot", "SWD", "r1.0max",
               "3888-2 km/h");
+  // The same table as CSV (numbers in shortest round-trip form; empty = no value).
+  OutputFile csv(csvPath);
+  csv << "place,vehicle,iso4138_limit_lateral_accel_m_s2,iso4138_rank,understeer_gradient_zero_deg_per_m_s2,"
+         "stability_lost_lateral_accel_m_s2,iso7401_yaw_response_time_s,iso7401_rank,yaw_peak_response_time_s,"
+         "yaw_overshoot,swd,swd_rank,max_yaw_ratio_1s,iso3888_highest_pass_km_h,iso3888_rank,mean_rank\n";
+  auto field = [](double v) { return std::isfinite(v) ? formatValue(v) : std::string(); };
+  auto rank = [](int k) { return k > 0 ? std::to_string(k) : std::string(); };
   int place = 0;
   for (const auto& r : rows) {
     const std::string rk = std::isfinite(r.mean) ? std::to_string(++place) : "-";
+    csv << (rk == "-" ? "" : rk) << ',' << r.name << ',' << field(r.ay) << ',' << rank(r.rank[0]) << ',' << field(r.k0)
+        << ',' << field(r.lost) << ',' << field(r.tr) << ',' << rank(r.rank[1]) << ',' << field(r.tpk) << ','
+        << field(r.os) << ',' << (r.hasSwd ? r.swd : "") << ',' << rank(r.rank[2]) << ',' << field(r.r1) << ','
+        << field(r.dlc) << ',' << rank(r.rank[3]) << ',' << field(r.mean) << '\n';
     std::printf("  %-4s %-14s | %-16s %-9s %-10s | %-12s %-10s %-9s | %-18s %-8s | %-14s\n", rk.c_str(),
                 r.name.c_str(), cell(sig(r.ay), r.rank[0]).c_str(), sig(r.k0, 3).c_str(),
                 r.has4138 ? (std::isfinite(r.lost) ? sig(r.lost, 3).c_str() : "never") : "-",
@@ -419,6 +492,7 @@ void printRanking(const Json& summary, const std::vector<std::string>& vehicles)
   std::printf("  K0 d/mps2: understeer gradient at zero a_y, deg/(m/s^2); unstable: a_y (m/s^2) where the "
               "R = 100 m sweep loses stability; SWD: pass, or the first failing amplitude and why (spin, r1.0 / r1.75 "
               "ratio, disp); r1.0max: largest 1.0 s yaw-rate ratio of the completed runs\n");
+  csv.commit();
 }
 }  // namespace
 
@@ -432,9 +506,11 @@ int main(int argc, char** argv) {
         "vehicle", po::value<std::string>()->default_value("4ws/2ws,4ws/linear,4ws/nonlinear,bicycle"),
         "comma-separated vehicles: 4ws/2ws, 4ws/linear, 4ws/nonlinear, bicycle")(
         "check", "ISO 7401: cross-check the frequency response with sine-steer simulations")(
+        "threads", po::value<int>()->default_value(0),
+        "worker threads for the independent runs (0: one per core); the outputs do not depend on it")(
         "no-plots", "skip the PNG plots");
-    const auto vm = study::parse("handling", "standard handling tests (ISO 4138, ISO 7401, sine with dwell)", argc,
-                                 argv, opts);
+    const auto vm = study::parse("handling", "standard handling tests (ISO 4138, ISO 7401, sine with dwell, ISO 3888-2)",
+                                 argc, argv, opts);
     Config c{ParamReader::fromFile(vm["data"].as<std::string>()), {}, {}, {}};
     c.fourws_data = c.data.string("vehicle_data");
     c.bicycle_data = c.data.string("bicycle_data");
@@ -449,20 +525,99 @@ int main(int argc, char** argv) {
     for (const auto& v : vehicles)
       if (v != "bicycle" && v != "4ws/2ws" && v != "4ws/linear" && v != "4ws/nonlinear")
         throw Error("--vehicle: unknown vehicle '" + v + "'; known: 4ws/2ws, 4ws/linear, 4ws/nonlinear, bicycle");
+    int threads = vm["threads"].as<int>();
+    if (threads < 0) throw Error("--threads must be non-negative, got " + std::to_string(threads));
+    if (threads == 0) threads = hardwareThreads();
     const std::string out = study::outputDir(vm, "handling");
     const bool plots = !vm.count("no-plots");
+    const bool check = vm.count("check") > 0;
+    auto has = [&](const char* t) { return std::find(tests.begin(), tests.end(), t) != tests.end(); };
+    const auto wall0 = std::chrono::steady_clock::now();
+    const double cpu0 = processCpuSeconds();
+    const std::size_t nv = vehicles.size();
+
+    // Every independent run is a job (runJobs: the sweep runner's threads),
+    // each building its own vehicle and writing only its own slot; the reports
+    // are made afterwards in vehicle and test order, so the outputs do not
+    // depend on the number of threads. Round 1: the sine with dwell's angle A
+    // per vehicle (its amplitude runs need it). Round 2: everything else, the
+    // long ISO 3888-2 searches (sequential rounds inside) first.
+    const SineWithDwellSettings swdSet = SineWithDwellSettings::fromParams(c.data.child("sine_with_dwell"));
+    std::vector<SineWithDwellResult> swd(nv);
+    if (has("swd"))
+      runJobs(nv, threads, [&](std::size_t v) {
+        swd[v].angle_A_rad = calcSineWithDwellAngle(build(c, vehicles[v])->vehicle, swdSet);
+      });
+    const std::vector<double> radii = c.data.child("iso4138").numbers("radii_m");
+    const std::vector<double> checkFreqs = c.data.child("iso7401").numbers("check_frequencies_Hz");
+    std::vector<Iso3888Job> dlc(nv);
+    std::vector<std::vector<ConstantRadiusResult>> cr(nv, std::vector<ConstantRadiusResult>(radii.size()));
+    std::vector<Iso7401Run> step(nv);
+    std::vector<std::vector<SineCheck>> checks(nv, std::vector<SineCheck>(check ? checkFreqs.size() : 0));
+    std::vector<std::vector<double>> factors(nv);
+    std::vector<std::function<void()>> jobs;
+    for (std::size_t v = 0; v < nv; ++v)
+      if (has("iso3888")) jobs.push_back([&, v] { dlc[v] = runIso3888Scene(c, vehicles[v], out, plots); });
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (!has("swd")) continue;
+      factors[v] = calcSineWithDwellFactors(swdSet, swd[v].angle_A_rad);
+      swd[v].runs.resize(factors[v].size());
+      for (std::size_t k = 0; k < factors[v].size(); ++k)
+        jobs.push_back([&, v, k] {
+          swd[v].runs[k] =
+              runSineWithDwellAmplitude(build(c, vehicles[v])->vehicle, swdSet, swd[v].angle_A_rad, factors[v][k]);
+        });
+    }
+    for (std::size_t v = 0; v < nv; ++v) {
+      if (has("iso7401")) {
+        jobs.push_back([&, v] { step[v] = runIso7401(c, vehicles[v]); });
+        for (std::size_t k = 0; k < checks[v].size(); ++k)
+          jobs.push_back([&, v, k] { checks[v][k] = runSineCheck(c, vehicles[v], checkFreqs[k]); });
+      }
+      if (has("iso4138"))
+        for (std::size_t k = 0; k < radii.size(); ++k)
+          jobs.push_back([&, v, k] { cr[v][k] = runIso4138(c, vehicles[v], radii[k]); });
+    }
+    runJobs(jobs.size(), threads, [&](std::size_t i) { jobs[i](); });
+
+    // Reports, counts.
+    long simRuns = 0, steps = 0, residuals = 0;
     Json summary = Json::object();
-    for (const auto& v : vehicles) {
+    for (std::size_t v = 0; v < nv; ++v) {
       Json jv = Json::object();
       for (const auto& t : tests) {
-        if (t == "iso4138") jv["iso4138"] = iso4138(c, v, out, plots);
-        if (t == "iso7401") jv["iso7401"] = iso7401(c, v, out, plots, vm.count("check") > 0);
-        if (t == "swd") jv["sine_with_dwell"] = sineWithDwell(c, v, out, plots);
-        if (t == "iso3888") jv["iso3888"] = iso3888(c, v, out, plots);
+        if (t == "iso4138") {
+          jv["iso4138"] = iso4138(c, vehicles[v], cr[v], out, plots);
+          for (const auto& r : cr[v]) residuals += r.residual_evaluations;
+        }
+        if (t == "iso7401") {
+          jv["iso7401"] = iso7401(c, vehicles[v], step[v], checks[v], out, plots, check);
+          simRuns += 1 + long(checks[v].size()), steps += step[v].step.run.steps;
+          for (const auto& k : checks[v]) steps += k.sim.run.steps;
+        }
+        if (t == "swd") {
+          SineWithDwellResult& r = swd[v];
+          r.pass = true;
+          for (const auto& q : r.runs) r.pass = r.pass && q.pass, steps += q.run.steps;
+          simRuns += long(r.runs.size());
+          jv["sine_with_dwell"] = sineWithDwell(c, vehicles[v], r, out, plots);
+        }
+        if (t == "iso3888") {
+          jv["iso3888"] = iso3888(vehicles[v], dlc[v], out);
+          simRuns += long(dlc[v].summary["runs"].size()), steps += dlc[v].steps;
+        }
       }
-      summary[v] = jv;
+      summary[vehicles[v]] = jv;
     }
-    printRanking(summary, vehicles);
+    printRanking(summary, vehicles, out + "/table.csv");
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    const double cpu = processCpuSeconds() - cpu0;
+    std::printf("\n  handling: %zu jobs on %d threads: %ld simulation runs (%ld integrator steps), %ld steady-state "
+                "residual evaluations; wall %.1f s, CPU %.1f s (all threads)\n",
+                jobs.size() + (has("swd") ? nv : 0), threads, simRuns, steps, residuals, wall, cpu);
+    summary["cost"] = {{"threads", threads}, {"jobs", jobs.size() + (has("swd") ? nv : 0)},
+                       {"simulation_runs", simRuns}, {"integrator_steps", steps},
+                       {"steady_state_residual_evaluations", residuals}, {"wall_time_s", wall}, {"cpu_time_s", cpu}};
     study::writeJson(out + "/summary.json", summary);
   });
 }

@@ -12,6 +12,7 @@
 #include <cmath>
 
 #include "vdyn/core/scene_file.h"
+#include "vdyn/core/sweep.h"
 #include "vdyn/handling/iso3888.h"
 #include "vdyn/handling/iso4138.h"
 #include "vdyn/handling/iso7401.h"
@@ -251,7 +252,9 @@ class SineWithDwellAnalysis : public Analysis {
  protected:
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
     auto b = buildHandlingScene(ctx.description, c_);
-    const SineWithDwellResult r = runSineWithDwell(b->vehicle, s_);
+    // The amplitude runs on the machine's cores, each on its own instance (the result does not depend on it).
+    const SineWithDwellResult r =
+        runSineWithDwell(makeHandlingVehicleMaker(ctx.description, c_), s_, hardwareThreads());
     AnalysisResult res;
     Table t;
     // A spun-out or failed run has no ratios (NaN cells, the reason in the summary).
@@ -308,7 +311,7 @@ class Iso3888Analysis : public Analysis {
   AnalysisResult DoRun(const AnalysisContext& ctx) const override {
     const auto t0 = std::chrono::steady_clock::now();
     const VehicleFootprint fp = calcVehicleFootprint(*ctx.built.vehicle, tire_width_m_);
-    const Iso3888Result r = findHighestPassingSpeed(ctx.description, s_, fp);
+    const Iso3888Result r = findHighestPassingSpeed(ctx.description, s_, fp, hardwareThreads());
     const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     if (ctx.animation) {
       // vdyn run --animation: the highest passing run once more, recorded

@@ -304,4 +304,12 @@ VehicleReport makeVehicleReport(const SceneDescription& d, const std::vector<dou
   throw Error(d.path() + ": vehicle_report runs on vehicle types wheeled (fourws) and quarter_car, not '" + type + "'");
 }
 
+HandlingVehicleMaker makeHandlingVehicleMaker(const SceneDescription& scene, const HandlingSetup& setup) {
+  auto desc = std::make_shared<const SceneDescription>(scene);
+  return [desc, setup]() -> std::shared_ptr<const HandlingVehicle> {
+    std::shared_ptr<HandlingScene> b = buildHandlingScene(*desc, setup);
+    return std::shared_ptr<const HandlingVehicle>(b, &b->vehicle);
+  };
+}
+
 }  // namespace vdyn

@@ -8,6 +8,7 @@
 #include "vdyn/core/animation.h"
 #include "vdyn/core/file_io.h"
 #include "vdyn/core/recorder.h"
+#include "vdyn/core/sweep.h"
 #include "vdyn/handling/handling.h"
 #include "vdyn/path_control/path_control.h"
 
@@ -139,6 +140,8 @@ void Iso3888Settings::validate() const {
     throw Error("ISO 3888-2 speed_high_m_s (" + formatValue(speed_high_m_s) + ") must exceed speed_low_m_s (" +
                 formatValue(speed_low_m_s) + ")");
   requirePositive(speed_tolerance_m_s, "ISO 3888-2 speed_tolerance_m_s");
+  if (speeds_per_round < 1 || speeds_per_round > 64)
+    throw Error("ISO 3888-2 speeds_per_round must be in [1, 64], got " + std::to_string(speeds_per_round));
   requirePositive(abort_path_error_m, "ISO 3888-2 abort_path_error_m");
   requirePositive(spin_limit_rad, "ISO 3888-2 spin_limit_rad");
   requirePositive(sample_s, "ISO 3888-2 sample_s");
@@ -162,7 +165,9 @@ const FieldTable<Iso3888Settings>& Iso3888Settings::fields() {
           .string("speed_hold", &S::speed_hold, "the scene's speed_hold plugin set to the entry speed; \"\" = coast")
           .number("speed_low_m_s", &S::speed_low_m_s, "m/s", "bisection bracket low end (must pass)")
           .number("speed_high_m_s", &S::speed_high_m_s, "m/s", "bisection bracket high end")
-          .number("speed_tolerance_m_s", &S::speed_tolerance_m_s, "m/s", "bisection stops at this bracket width")
+          .number("speed_tolerance_m_s", &S::speed_tolerance_m_s, "m/s", "the search stops at this bracket width")
+          .integer("speeds_per_round", &S::speeds_per_round, "",
+                   "speeds run at once per round: 1 = bisection, k - 1 = k-section (runs on threads)")
           .number("abort_path_error_m", &S::abort_path_error_m, "m", "a run this far off the path stops and fails")
           .number("spin_limit_rad", &S::spin_limit_rad, "rad", "|side slip| beyond this: spin-out, fails")
           .number("sample_s", &S::sample_s, "s", "sampling of the motion (cone check)")
@@ -329,16 +334,22 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
 }
 
 Iso3888Result findHighestPassingSpeed(const SceneDescription& desc, const Iso3888Settings& set,
-                                      const VehicleFootprint& fp) {
+                                      const VehicleFootprint& fp, int threads) {
   set.validate();
   Iso3888Result r;
   r.body = fp.body(set);
   r.layout = Iso3888Layout::make(2 * r.body.half_width_m, set.entry_x_m);
-  auto run = [&](double U) {
-    r.runs.push_back(runIso3888(desc, set, r.layout, r.body, U));
-    return int(r.runs.size()) - 1;
+  // One round: the speeds' runs on the threads, appended to r.runs in speed order.
+  auto runRound = [&](const std::vector<double>& speeds) {
+    std::vector<Iso3888Run> round(speeds.size());
+    runJobs(speeds.size(), threads,
+            [&](std::size_t i) { round[i] = runIso3888(desc, set, r.layout, r.body, speeds[i]); });
+    const int first = int(r.runs.size());
+    for (auto& q : round) r.runs.push_back(std::move(q));
+    return first;
   };
-  int lo = run(set.speed_low_m_s);
+  int lo = runRound({set.speed_low_m_s, set.speed_high_m_s});
+  int hi = lo + 1;
   if (!r.runs[lo].pass) {
     const Iso3888Run& q = r.runs[lo];
     std::string why = q.completed ? std::to_string(q.cones.strikes.size()) + " cone line(s) struck, first in section " +
@@ -348,7 +359,6 @@ Iso3888Result findHighestPassingSpeed(const SceneDescription& desc, const Iso388
     throw Error("ISO 3888-2: the bracket's low end speed_low_m_s = " + formatValue(set.speed_low_m_s) +
                 " m/s does not pass (" + why + "); lower it");
   }
-  int hi = run(set.speed_high_m_s);
   if (r.runs[hi].pass) {
     r.top_passes = true;
     r.best_run = hi;
@@ -357,13 +367,19 @@ Iso3888Result findHighestPassingSpeed(const SceneDescription& desc, const Iso388
     return r;
   }
   double a = set.speed_low_m_s, b = set.speed_high_m_s;
+  const int k = set.speeds_per_round + 1;
   while (b - a > set.speed_tolerance_m_s) {
-    const double m = 0.5 * (a + b);
-    const int k = run(m);
-    if (r.runs[k].pass)
-      a = m, lo = k;
-    else
-      b = m, hi = k;
+    std::vector<double> speeds;
+    for (int i = 1; i < k; ++i) speeds.push_back(k == 2 ? 0.5 * (a + b) : a + i * (b - a) / k);
+    const int first = runRound(speeds);
+    // The lowest failing speed of the round bounds the bracket from above;
+    // the speed below it (a round's speed or a) passes.
+    int fail = -1;
+    for (int i = 0; i < int(speeds.size()) && fail < 0; ++i)
+      if (!r.runs[first + i].pass) fail = i;
+    const int passIdx = fail < 0 ? int(speeds.size()) - 1 : fail - 1;
+    if (passIdx >= 0) a = speeds[passIdx], lo = first + passIdx;
+    if (fail >= 0) b = speeds[fail], hi = first + fail;
   }
   r.best_run = lo;
   r.first_fail_run = hi;

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "vdyn/core/sweep.h"
+
 namespace vdyn {
 
 void SineWithDwellSettings::validate() const {
@@ -122,51 +124,73 @@ void evaluateSineWithDwellRun(const HandlingHistory& h, const SineWithDwellTimes
              (run.factor < set.displacement_from_factor - 1e-9 || run.lateral_displacement_m >= set.displacement_limit_m);
 }
 
-SineWithDwellResult runSineWithDwell(const HandlingVehicle& v, const SineWithDwellSettings& set) {
+double calcSineWithDwellAngle(const HandlingVehicle& v, const SineWithDwellSettings& set) {
   set.validate();
   v.validate();
-  SineWithDwellResult out;
+  return solveSteeringForLateralAcceleration(v, set.speed_m_s, set.lateral_accel_m_s2);
+}
+
+std::vector<double> calcSineWithDwellFactors(const SineWithDwellSettings& set, double angleA) {
+  std::vector<double> k;
+  for (double f = set.first_factor; f <= set.max_amplitude_factor + 1e-9; f += set.factor_step) {
+    k.push_back(f);
+    if (f * angleA >= set.max_amplitude_rad) break;
+  }
+  return k;
+}
+
+SineWithDwellRun runSineWithDwellAmplitude(const HandlingVehicle& v, const SineWithDwellSettings& set, double angleA,
+                                           double k) {
+  set.validate();
+  v.validate();
   const double U = set.speed_m_s;
-  out.angle_A_rad = solveSteeringForLateralAcceleration(v, U, set.lateral_accel_m_s2);
   const double w = 2 * SimTK::Pi * set.frequency_Hz, T = 1 / set.frequency_Hz, t0 = set.start_s, dw = set.dwell_s;
   const double tCos = t0 + T + dw;  // completion of steer
-  out.pass = true;
-  for (double k = set.first_factor; k <= set.max_amplitude_factor + 1e-9; k += set.factor_step) {
-    SineWithDwellRun run;
-    run.factor = k;
-    run.amplitude_rad = std::min(k * out.angle_A_rad, set.max_amplitude_rad);
-    const double A = run.amplitude_rad;
-    // delta = A sin(w tau) up to 3/4 period, held at -A for the dwell, then the
-    // last quarter; zero before BOS and from COS on. The rate jumps (0 <-> A w)
-    // at BOS and COS: the run restarts there, the command taken from the right.
-    const double tEndSteer = T + dw;
-    v.setSteering(U, [A, w, T, t0, dw, tEndSteer](double t) {
-      const double tau = t - t0;
-      if (tau < 0 || tau >= tEndSteer) return SteerCommandValue{0, 0, 0};
-      if (tau >= 0.75 * T && tau < 0.75 * T + dw) return SteerCommandValue{-A, 0, 0};
-      const double x = tau >= 0.75 * T + dw ? tau - dw : tau;
-      return SteerCommandValue{A * std::sin(w * x), A * w * std::cos(w * x), -A * w * w * std::sin(w * x)};
-    });
-    try {
-      run.history = runHandlingTransient(v, U, tCos + set.after_s, set.sample_s, set.integrator, 0.5, nullptr,
-                                         {t0, tCos}, set.coast ? t0 : 1e300);
-      run.completed = true;
-    } catch (const Error& e) {
-      run.reason = e.what();
-    }
-    if (run.completed) {
-      SineWithDwellTimes times;
-      times.bos_s = t0, times.reversal_s = t0 + 0.5 * T, times.cos_s = tCos;
-      times.first_steer_sign = A >= 0 ? 1 : -1;
-      evaluateSineWithDwellRun(run.history, times, set, run);
-    } else {
-      run.spun_out = run.reason.find("spun out") != std::string::npos;
-    }
-    out.pass = out.pass && run.pass;
-    out.runs.push_back(std::move(run));
-    if (k * out.angle_A_rad >= set.max_amplitude_rad) break;
+  SineWithDwellRun run;
+  run.factor = k;
+  run.amplitude_rad = std::min(k * angleA, set.max_amplitude_rad);
+  const double A = run.amplitude_rad;
+  // delta = A sin(w tau) up to 3/4 period, held at -A for the dwell, then the
+  // last quarter; zero before BOS and from COS on. The rate jumps (0 <-> A w)
+  // at BOS and COS: the run restarts there, the command taken from the right.
+  const double tEndSteer = T + dw;
+  v.setSteering(U, [A, w, T, t0, dw, tEndSteer](double t) {
+    const double tau = t - t0;
+    if (tau < 0 || tau >= tEndSteer) return SteerCommandValue{0, 0, 0};
+    if (tau >= 0.75 * T && tau < 0.75 * T + dw) return SteerCommandValue{-A, 0, 0};
+    const double x = tau >= 0.75 * T + dw ? tau - dw : tau;
+    return SteerCommandValue{A * std::sin(w * x), A * w * std::cos(w * x), -A * w * w * std::sin(w * x)};
+  });
+  try {
+    run.history = runHandlingTransient(v, U, tCos + set.after_s, set.sample_s, set.integrator, 0.5, &run.run,
+                                       {t0, tCos}, set.coast ? t0 : 1e300);
+    run.completed = true;
+  } catch (const Error& e) {
+    run.reason = e.what();
+  }
+  if (run.completed) {
+    SineWithDwellTimes times;
+    times.bos_s = t0, times.reversal_s = t0 + 0.5 * T, times.cos_s = tCos;
+    times.first_steer_sign = A >= 0 ? 1 : -1;
+    evaluateSineWithDwellRun(run.history, times, set, run);
+  } else {
+    run.spun_out = run.reason.find("spun out") != std::string::npos;
   }
   v.holdSteering(U, 0);
+  return run;
+}
+
+SineWithDwellResult runSineWithDwell(const HandlingVehicleMaker& make, const SineWithDwellSettings& set, int threads) {
+  set.validate();
+  SineWithDwellResult out;
+  out.angle_A_rad = calcSineWithDwellAngle(*make(), set);
+  const std::vector<double> factors = calcSineWithDwellFactors(set, out.angle_A_rad);
+  out.runs.resize(factors.size());
+  runJobs(factors.size(), threads, [&](std::size_t i) {
+    out.runs[i] = runSineWithDwellAmplitude(*make(), set, out.angle_A_rad, factors[i]);
+  });
+  out.pass = true;
+  for (const auto& r : out.runs) out.pass = out.pass && r.pass;
   return out;
 }
 

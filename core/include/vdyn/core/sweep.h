@@ -222,6 +222,23 @@ struct SweepResult {
 /// writes results.csv, results.json and sweep_stats.json.
 SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, const SweepOptions& options);
 
+/// Independent jobs of one program (a study's or an analysis's runs whose
+/// results go to slots indexed by job) through the sweep runner's threads:
+/// job(i) for every i in [0, n), taken one at a time by up to `threads`
+/// (>= 1) threads (1: in the calling thread, in order). Each job must build
+/// what it mutates (its own scene, system and state) and write only its own
+/// slot, so the results do not depend on the number of threads. After all
+/// jobs end, the failure of the lowest index, if any, is rethrown as Error
+/// with its message. Returns the wall and CPU time (the process's, all threads).
+struct JobsTiming {
+  double wall_s = 0, cpu_s = 0;
+  int workers = 0;
+};
+JobsTiming runJobs(std::size_t n, int threads, const std::function<void(std::size_t)>& job);
+/// The machine's cores (std::thread::hardware_concurrency, at least 1): the
+/// default thread count of the studies and analyses that run jobs.
+int hardwareThreads();
+
 // --- pieces shared with the MPI runner ------------------------------------------
 /// Journal line of a row (compact JSON, no line break).
 std::string sweepJournalLine(const SweepDescription& d, const SweepRow& row);

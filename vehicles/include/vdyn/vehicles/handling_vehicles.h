@@ -64,6 +64,11 @@ VehicleFootprint calcVehicleFootprint(const Vehicle& vehicle, double tire_width_
 /// scene). Throws Error naming the scene if the vehicle has no front_axle.
 std::unique_ptr<HandlingScene> buildHandlingScene(const SceneDescription& scene, const HandlingSetup& setup);
 
+/// A maker of independent instances of the vehicle (one per run of a test on
+/// several threads): each call builds `scene` anew with buildHandlingScene; the
+/// instance owns its HandlingScene.
+HandlingVehicleMaker makeHandlingVehicleMaker(const SceneDescription& scene, const HandlingSetup& setup);
+
 /// Vehicle report at rest on a flat road with the steering held at zero.
 struct VehicleReport {
   std::string vehicle;

@@ -87,6 +87,12 @@ struct HandlingVehicle {
   double rearAngle(double speed_m_s, double front_rad) const;
 };
 
+/// Makes a new instance of a vehicle (its own scene, system and commands; the
+/// shared_ptr owns them): what a test needs to run independent runs on
+/// several threads (one instance per run). Must be callable from several
+/// threads at once.
+using HandlingVehicleMaker = std::function<std::shared_ptr<const HandlingVehicle>()>;
+
 /// Adds the outputs the transient tests record; call before making states:
 /// handling.lateral_accel_m_s2 (chassis origin acceleration along the
 /// horizontal left of the heading, Stage::Acceleration), handling.front_rad and

@@ -111,7 +111,7 @@ struct Iso3888Settings {
   /// Keys as the fields (all optional): vehicle_width_m, front_overhang_m,
   /// rear_overhang_m, entry_x_m, lead_out_m, transition_extension_m, line_clearance_m, path_controller,
   /// speed_hold, speed_low_m_s, speed_high_m_s, speed_tolerance_m_s,
-  /// abort_path_error_m, sample_s, max_steps, integrator.
+  /// speeds_per_round, abort_path_error_m, sample_s, max_steps, integrator.
   static Iso3888Settings fromParams(const ParamReader& r);
   /// The keys (read by fromParams, listed by `vdyn list`).
   static const FieldTable<Iso3888Settings>& fields();
@@ -128,7 +128,12 @@ struct Iso3888Settings {
   std::string speed_hold;              ///< the scene's speed-hold plugin ("" = coast)
   double speed_low_m_s = 8.0;          ///< bracket: must pass
   double speed_high_m_s = 30.0;        ///< bracket: the top (may pass: reported as such)
-  double speed_tolerance_m_s = 0.1;    ///< bisection stops when the bracket is this narrow
+  double speed_tolerance_m_s = 0.1;    ///< the search stops when the bracket is this narrow
+  /// Entry speeds run per round of the search: 1 = bisection; k - 1 = a
+  /// k-section (the bracket cut into k equal parts, its k - 1 inner speeds run
+  /// at once: fewer sequential rounds for more runs, a gain where there are
+  /// threads to run them). The result depends on it, not on the threads.
+  int speeds_per_round = 1;
   double abort_path_error_m = 2.0;     ///< a run this far from the path is stopped (fails)
   double spin_limit_rad = 0.5;         ///< |side slip| beyond this: spin-out (fails)
   double sample_s = 0.005;
@@ -190,11 +195,17 @@ struct Iso3888Result {
   int best_run = -1, first_fail_run = -1;  ///< indices into runs
 };
 
-/// Bisection on the entry speed: low must pass (else Error naming why), high
-/// is tried next; then the bracket halves until narrower than the tolerance.
+/// Search on the entry speed: low and high are run (low must pass, else Error
+/// naming why); while the bracket [a, b] (a passes, b fails) is wider than the
+/// tolerance, a round runs speeds_per_round speeds a + i (b - a) / k (k =
+/// speeds_per_round + 1, i = 1..k-1) and takes the new bracket between the
+/// lowest failing one and the passing speed below it (bisection for k = 2).
 /// Pass/fail need not be monotonic in speed: the result is a passing speed
-/// with a failing one within the tolerance above it.
+/// with a failing one within the tolerance above it. The runs of a round (and
+/// low and high) are independent: they run on up to `threads` threads
+/// (runJobs, vdyn/core/sweep.h), each building its own scene; the result and
+/// the order of `runs` do not depend on `threads`.
 Iso3888Result findHighestPassingSpeed(const SceneDescription& scene, const Iso3888Settings& settings,
-                                      const VehicleFootprint& footprint);
+                                      const VehicleFootprint& footprint, int threads = 1);
 
 }  // namespace vdyn

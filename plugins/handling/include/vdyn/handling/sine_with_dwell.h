@@ -71,6 +71,7 @@ struct SineWithDwellRun {
   double lateral_displacement_m = 0;  ///< at BOS + 1.07 s, + toward the first steer
   bool pass = false;
   HandlingHistory history;
+  RunSummary run;  ///< the integration's counts (steps, ...; a run that threw: zeros)
 };
 
 struct SineWithDwellResult {
@@ -98,6 +99,22 @@ struct SineWithDwellTimes {
 void evaluateSineWithDwellRun(const HandlingHistory& history, const SineWithDwellTimes& times,
                               const SineWithDwellSettings& settings, SineWithDwellRun& run);
 
-SineWithDwellResult runSineWithDwell(const HandlingVehicle& vehicle, const SineWithDwellSettings& settings);
+/// The angle A, rad: the front angle of the steady turn at speed_m_s with
+/// lateral_accel_m_s2 (solveSteeringForLateralAcceleration).
+double calcSineWithDwellAngle(const HandlingVehicle& vehicle, const SineWithDwellSettings& settings);
+/// The amplitude factors run for an angle A: first_factor, + factor_step, ...
+/// up to max_amplitude_factor, the last one the first whose amplitude reaches
+/// max_amplitude_rad.
+std::vector<double> calcSineWithDwellFactors(const SineWithDwellSettings& settings, double angle_A_rad);
+/// One run at amplitude min(factor A, max_amplitude_rad). Sets the vehicle's
+/// steering (its commands are the run's: one run at a time per vehicle).
+SineWithDwellRun runSineWithDwellAmplitude(const HandlingVehicle& vehicle, const SineWithDwellSettings& settings,
+                                           double angle_A_rad, double factor);
+
+/// The whole test: A, then the amplitude runs, independent of each other, on
+/// up to `threads` threads (runJobs, vdyn/core/sweep.h), each on its own
+/// vehicle from `make`; the result does not depend on `threads`.
+SineWithDwellResult runSineWithDwell(const HandlingVehicleMaker& make, const SineWithDwellSettings& settings,
+                                     int threads = 1);
 
 }  // namespace vdyn
