@@ -247,8 +247,8 @@ struct RollRun {
   SimTK::State state;
 };
 
-/// Static equilibrium under the roll moment (the steady-state equations at
-/// zero speed: chassis x, y, yaw and the spins ineffective), on the
+/// Static equilibrium under the roll moment (makeRestProblem: speeds held at
+/// zero, chassis x, y, yaw and the spins ineffective), on the
 /// constrained double wishbone (the steady-state solver's model of the
 /// vehicle report).
 RollRun rollUnder(bool bar, double moment_N_m) {
@@ -257,7 +257,7 @@ RollRun rollUnder(bool bar, double moment_N_m) {
   const Scene& sc = r.car->getScene();
   std::vector<std::string> wheels;
   for (int c = 0; c < r.car->numCorners(); ++c) wheels.push_back(r.car->cornerName(c) + ".wheel");
-  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", wheels, 0));
+  SteadyStateSolver solver(sc, makeRestProblem(sc, "chassis", wheels, 0));
   r.state = solver.solve(r.car->makeInitialState(0.0)).state;
   sc.getSystem().realize(r.state, SimTK::Stage::Position);
   const SimTK::Rotation R = r.car->chassis().getBodyRotation(r.state);

@@ -273,7 +273,7 @@ TEST(RegistryKeys, WheeledListsItsTemplatesAndForwardDynamics) {
   std::set<std::string> strut;
   for (const auto& f : standardRegistry().choiceInfo("suspension_template", "macpherson_strut").fields) strut.insert(f.key);
   EXPECT_EQ(strut, (std::set<std::string>{"bodies", "hardpoints_m", "tie_rod", "camber_rad", "toe_in_rad", "spring"}));
-  EXPECT_EQ(defaults["data: formulation"], "\"constrained\"");
+  EXPECT_EQ(defaults["data: formulation"], "\"auto\"");
   EXPECT_EQ(defaults["data: gravity_m_per_s2"], "9.81");
 }
 

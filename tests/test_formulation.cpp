@@ -14,6 +14,7 @@
 
 #include <gtest/gtest.h>
 
+#include "vdyn/analyses/branch_analyses.h"
 #include "vdyn/core/analysis.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/vehicles/standard_registry.h"
@@ -175,4 +176,37 @@ TEST(Formulation, Iso7401DenseAgreesWithConstrained) {
   for (const char* k : {"/yaw_rate_phase_1Hz_deg", "/lateral_accel_phase_1Hz_deg", "/linear_yaw_gain_zero_1_per_s",
                         "/lateral_accel_gain_ratio_1Hz"})
     expectSummaryNear(au, con, k, 1e-5);
+}
+
+// Chapter 6 (scenes/ch6_steering_ratio.json: 20 m/s, front 0.5-3 deg): the
+// Kr of zero steady side slip, |beta| <= 1e-9 rad (side_slip_tolerance_rad),
+// on both forms. As shipped (force tolerance 1e-6 N) the constrained run
+// stops short at 3 deg: the steady state of its Kr step stalls (no descent
+// along a fresh Jacobian's direction, 44 N left) and the point is reported
+// as least side slip (beta 1.5e-3 rad at Kr 0.5548). A third computation, the
+// constrained model at 1e-9 N (or with 4 Kr bisections), reaches the zero the
+// dense form finds (Kr 0.5532814097): the constrained run's infeasible point
+// is the solver's, not the model's. Each Kr is within (1e-9 rad + beta's
+// error from the force tolerance, 1e-6 N / 1.4e5 N/rad) / |d beta / d Kr| of
+// its zero; the two within twice that.
+TEST(Formulation, Ch6SteeringRatioDenseAgreesWithConstrained) {
+  auto follow = [](const std::string& formulation, std::vector<Override> o) {
+    o.push_back({"vehicle.overrides.formulation", formulation});
+    const SceneDescription d = SceneDescription::fromFile("scenes/ch6_steering_ratio.json", standardRegistry(), o);
+    BuiltScene b = d.build();
+    return OptimalRatioAnalysis::fromScene(b).follow(b);
+  };
+  const OptimalRatioRun con = follow("constrained", {{"analysis.force_tolerance_N", 1e-9}});
+  const OptimalRatioRun au = follow("auto", {});
+  ASSERT_EQ(con.points.size(), 6u);
+  ASSERT_EQ(au.points.size(), 6u);
+  for (std::size_t i = 0; i < 6; ++i) {
+    const OptimalRatioPoint &c = con.points[i], &a = au.points[i];
+    EXPECT_EQ(c.status, OptimalRatioStatus::ZeroSideSlip) << i << ": " << c.failure;
+    EXPECT_EQ(a.status, OptimalRatioStatus::ZeroSideSlip) << i << ": " << a.failure;
+    const double bound = 2 * (1e-9 + 1e-6 / 1.4e5) / std::abs(c.dbeta_dkr_rad);
+    EXPECT_NEAR(a.kr, c.kr, bound) << "front " << c.front_rad << " rad";
+    std::printf("ch6 front %.4f rad: Kr dense %.12f constrained (1e-9 N) %.12f, bound %.2e\n", c.front_rad, a.kr, c.kr,
+                bound);
+  }
 }

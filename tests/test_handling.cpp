@@ -234,27 +234,38 @@ TEST(Iso7401, GimTireFrequencyResponseAboutATurnMatchesSineSteerSimulations) {
   }
 }
 
+// On the constrained templates (the reference) and the formulation the
+// framework picks (auto: the reduced templates, dense rows): the same static
+// loads to the force tolerance (1e-6 N).
 TEST(VehicleReport, StaticLoadsBalanceTheWeightAndKinematicsAreConsistent) {
-  const Json scene = {{"name", "report"},
-                      {"vehicle", {{"type", "fourws"}, {"data", "appendix_a.json"}}},
-                      {"analysis", {{"type", "vehicle_report"}}}};
-  const VehicleReport r =
-      makeVehicleReport(SceneDescription::fromJson(scene, "", standardRegistry()), {-0.08, 0.0, 0.08});
-  std::printf("4ws: loads %.2f %.2f %.2f %.2f N (sum %.3f, weight %.3f), c.m. height %.4f m, %d iterations\n",
-              r.corner_loads_N[0].second, r.corner_loads_N[1].second, r.corner_loads_N[2].second,
-              r.corner_loads_N[3].second, r.total_load_N, r.weight_N, r.com_height_m, r.iterations);
-  // The tires carry the weight (the steady-state solver at zero speed is a static equilibrium).
-  EXPECT_NEAR(r.total_load_N, r.weight_N, 1e-6 * r.weight_N);
-  // Left and right corners mirror each other.
-  EXPECT_NEAR(r.corner_loads_N[0].second, r.corner_loads_N[1].second, 1e-6 * r.corner_loads_N[0].second);
-  for (const auto& [axle, pts] : r.kinematics) {
-    ASSERT_EQ(pts.size(), 3u);
-    EXPECT_NEAR(pts[1].track_change_m, 0.0, 1e-12) << axle;
-    EXPECT_NEAR(pts[1].recession_m, 0.0, 1e-12) << axle;
-    EXPECT_GT(pts[1].wheel_rate_N_per_m, 0.0) << axle;
-    std::printf("%s: camber %.4f/%.4f/%.4f deg, track %.5f/%.5f m, rate %.0f N/m, roll centre %.4f m\n", axle.c_str(),
-                pts[0].camber_rad / kDeg, pts[1].camber_rad / kDeg, pts[2].camber_rad / kDeg, pts[0].track_change_m,
-                pts[2].track_change_m, pts[1].wheel_rate_N_per_m, pts[1].roll_centre_height_m);
+  std::vector<double> reference;
+  for (const char* formulation : {"constrained", "auto"}) {
+    const Json scene = {{"name", "report"},
+                        {"vehicle", {{"type", "fourws"}, {"data", "appendix_a.json"},
+                                     {"overrides", {{"formulation", formulation}}}}},
+                        {"analysis", {{"type", "vehicle_report"}}}};
+    const VehicleReport r =
+        makeVehicleReport(SceneDescription::fromJson(scene, "", standardRegistry()), {-0.08, 0.0, 0.08});
+    if (reference.empty())
+      for (const auto& [corner, fz] : r.corner_loads_N) reference.push_back(fz);
+    else
+      for (int c = 0; c < 4; ++c) EXPECT_NEAR(r.corner_loads_N[c].second, reference[c], 1e-5) << formulation;
+    std::printf("4ws (%s): loads %.2f %.2f %.2f %.2f N (sum %.3f, weight %.3f), c.m. height %.4f m, %d iterations\n",
+                formulation, r.corner_loads_N[0].second, r.corner_loads_N[1].second, r.corner_loads_N[2].second,
+                r.corner_loads_N[3].second, r.total_load_N, r.weight_N, r.com_height_m, r.iterations);
+    // The tires carry the weight (makeRestProblem: a static equilibrium).
+    EXPECT_NEAR(r.total_load_N, r.weight_N, 1e-6 * r.weight_N);
+    // Left and right corners mirror each other.
+    EXPECT_NEAR(r.corner_loads_N[0].second, r.corner_loads_N[1].second, 1e-6 * r.corner_loads_N[0].second);
+    for (const auto& [axle, pts] : r.kinematics) {
+      ASSERT_EQ(pts.size(), 3u);
+      EXPECT_NEAR(pts[1].track_change_m, 0.0, 1e-12) << axle;
+      EXPECT_NEAR(pts[1].recession_m, 0.0, 1e-12) << axle;
+      EXPECT_GT(pts[1].wheel_rate_N_per_m, 0.0) << axle;
+      std::printf("%s: camber %.4f/%.4f/%.4f deg, track %.5f/%.5f m, rate %.0f N/m, roll centre %.4f m\n", axle.c_str(),
+                  pts[0].camber_rad / kDeg, pts[1].camber_rad / kDeg, pts[2].camber_rad / kDeg, pts[0].track_change_m,
+                  pts[2].track_change_m, pts[1].wheel_rate_N_per_m, pts[1].roll_centre_height_m);
+    }
   }
 }
 

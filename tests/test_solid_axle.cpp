@@ -368,11 +368,11 @@ TEST(SolidAxle, AppendixASolidRearCarriesItsWeightAndCoastsStraight) {
   // Chassis 6 + front 2 x (arm 1 + knuckle 3 + upper arm 1 + spin 1 - ball 3 - steer 1)
   // + rear (housing 6 + 2 spins - 4 links).
   EXPECT_EQ(car.degreesOfFreedom(s0), 14);
-  // Static equilibrium: the steady-state equations at zero speed (chassis x,
-  // y, yaw and the spin angles ineffective), as the vehicle report solves them.
+  // Static equilibrium (makeRestProblem: speeds held at zero, chassis x, y,
+  // yaw and the spin angles ineffective), as the vehicle report solves it.
   std::vector<std::string> wheels;
   for (int c = 0; c < car.numCorners(); ++c) wheels.push_back(car.cornerName(c) + ".wheel");
-  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", wheels, 0));
+  SteadyStateSolver solver(sc, makeRestProblem(sc, "chassis", wheels, 0));
   SimTK::State s = solver.solve(s0).state;
   sc.getSystem().realize(s, SimTK::Stage::Velocity);
   const double weight = car.totalMass() * data.gravity_m_per_s2;

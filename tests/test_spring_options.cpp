@@ -23,7 +23,7 @@ struct Rest {
   SimTK::State state;
 };
 
-/// The vehicle at rest: the steady-state solver at zero speed, the front held straight.
+/// The vehicle at rest: the steady-state solver's static equilibrium (makeRestProblem), the front held straight.
 Rest restOf(const WheeledVehicleParams& p, const std::vector<std::string>& outputs = {}) {
   WheeledVehicle car(p);
   car.addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(0.0));
@@ -36,7 +36,7 @@ Rest restOf(const WheeledVehicleParams& p, const std::vector<std::string>& outpu
   Rest r;
   sc.getSystem().realize(s0, SimTK::Stage::Position);
   for (int c = 0; c < car.numCorners(); ++c) r.design_length_m.push_back(car.suspension(c / 2).calcSpringLength(s0, c % 2));
-  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", wheels, 0.0));
+  SteadyStateSolver solver(sc, makeRestProblem(sc, "chassis", wheels, 0.0));
   r.state = solver.solve(s0).state;
   sc.getSystem().realize(r.state, SimTK::Stage::Dynamics);
   for (int c = 0; c < car.numCorners(); ++c) {
@@ -103,6 +103,63 @@ TEST(RideHeight, SpringsAtDesignLengthAtRestWhateverTheirStiffness) {
   p2.withRideHeightSprings(vehiclePlugins(), &r2);
   EXPECT_GT(r2.free_length_m[2], r1.free_length_m[2] + 1e-3);
   EXPECT_NEAR(r2.free_length_m[0], r1.free_length_m[0], 1e-3);  // the front barely changes
+}
+
+// The static equilibrium on every formulation (issue 24): App. A with the
+// ride-height option and a rear bump stop that carries load at rest, solved on
+// the constrained templates (the reference), the reduced ones and the dense
+// rows. Each rest meets the force tolerance (1e-6 N) on springs and tires of
+// 1e4-1e5 N/m, so positions agree to ~1e-10 m, the stop force to ~1e-5 N.
+TEST(RideHeight, RestIsTheSameOnEveryFormulation) {
+  WheeledVehicleParams p = appendixA();
+  p.spring_free_length_from_ride_height = true;
+  const WheeledVehicleParams q = p.withRideHeightSprings(vehiclePlugins());
+  WheeledVehicleParams s = q;
+  const double lb = restOf(q).spring_length_m[2] + 0.005, kb = 2e5;
+  s.updAxle("rear").suspension.block["spring"]["bump_stop"] = {{"length_m", lb}, {"stiffness_N_per_m", kb}};
+  std::map<std::string, Rest> rest;
+  for (const char* f : {"constrained", "reduced", "dense"}) {
+    WheeledVehicleParams v = s;
+    v.formulation = f;
+    rest[f] = restOf(v, {"rr.bump_stop_N"});
+    double sum = 0;
+    for (double x : rest[f].fz_N) sum += x;
+    EXPECT_NEAR(sum, rest[f].weight_N, 1e-9 * rest[f].weight_N) << f;
+    EXPECT_GT(rest[f].outputs.at("rr.bump_stop_N"), 100.0) << f;
+  }
+  const Rest& ref = rest.at("constrained");
+  for (const char* f : {"reduced", "dense"}) {
+    const Rest& r = rest.at(f);
+    EXPECT_NEAR(r.chassis_z_m, ref.chassis_z_m, 1e-10) << f;
+    for (int c = 0; c < 4; ++c) {
+      EXPECT_NEAR(r.spring_length_m[c], ref.spring_length_m[c], 1e-10) << f << " corner " << c;
+      EXPECT_NEAR(r.fz_N[c], ref.fz_N[c], 1e-5) << f << " corner " << c;
+    }
+    EXPECT_NEAR(r.outputs.at("rr.bump_stop_N"), ref.outputs.at("rr.bump_stop_N"), 1e-5) << f;
+    std::printf("rest on %s: chassis z %.12f m (constrained %.12f), rr bump stop %.6f N (%.6f)\n", f, r.chassis_z_m,
+                ref.chassis_z_m, r.outputs.at("rr.bump_stop_N"), ref.outputs.at("rr.bump_stop_N"));
+  }
+}
+
+// The static equilibrium holds every speed at zero (makeRestProblem): its
+// unknowns are the turning problem's less the chassis yaw rate, horizontal
+// velocity and the four spins; the equations of those mobilities are checked,
+// not solved, so a push along x (10 N on the chassis), which no position
+// balances, is an error that names the equation.
+TEST(RideHeight, RestProblemHoldsTheSpeedsAndChecksTheCyclicEquations) {
+  WheeledVehicle car(appendixA());
+  car.addAxleSteering("front_steer", "front", std::make_shared<HoldCommand>(0.0));
+  car.addAxleSteering("rear_steer", "rear", std::make_shared<HoldCommand>(0.0));
+  SimTK::Force::ConstantForce(car.updScene().updForces(), car.chassis(), SimTK::Vec3(0), SimTK::Vec3(10.0, 0, 0));
+  std::vector<std::string> wheels;
+  for (int c = 0; c < car.numCorners(); ++c) wheels.push_back(car.cornerName(c) + ".wheel");
+  const Scene& sc = car.getScene();
+  SteadyStateSolver rest(sc, makeRestProblem(sc, "chassis", wheels, 0.0));
+  SteadyStateSolver turn(sc, makeSteadyTurningProblem(sc, "chassis", wheels, 0.0));
+  EXPECT_EQ(rest.numUnknowns(), turn.numUnknowns() - 7);
+  const std::string e = errorOf([&] { rest.solve(car.makeInitialState(0.0)); });
+  EXPECT_NE(e.find("generalized force u[3] (mobilizer of body 1, its u 3) = -10"), std::string::npos) << e;
+  EXPECT_NE(e.find("checked, not solved"), std::string::npos) << e;
 }
 
 TEST(RideHeight, MacPhersonE90AtItsDesignHeight) {

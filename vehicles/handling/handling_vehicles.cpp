@@ -198,10 +198,10 @@ VehicleReport makeWheeledReport(const HandlingScene& h, const std::vector<double
   const WheeledVehicle& car = h.built.vehicleAs<WheeledVehicle>();
   const WheeledVehicleParams& params = car.params();
   const Scene& sc = h.built.scene();
-  // Static equilibrium: the steady-state equations at zero speed (no speed
-  // hold): the chassis x, y, yaw and wheel spin angles are ineffective, the
-  // speeds are unknowns that solve to zero.
-  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, h.vehicle.chassis_body, h.vehicle.wheel_bodies, 0));
+  // Static equilibrium (makeRestProblem): every speed held at zero, the
+  // chassis x, y, yaw and wheel spin angles ineffective, their equations
+  // checked (the tires carry no in-plane force at rest).
+  SteadyStateSolver solver(sc, makeRestProblem(sc, h.vehicle.chassis_body, h.vehicle.wheel_bodies, 0));
   const SteadyStateResult r = solver.solve(h.vehicle.make_initial_state(0.0));
   SimTK::State s = r.state;
   sc.getSystem().realize(s, SimTK::Stage::Velocity);

@@ -70,7 +70,7 @@ WheeledVehicleParams WheeledVehicleParams::withRideHeightSprings(const PluginReg
     const WheeledVehicle& car = *carPtr;
     std::vector<std::string> wheels;
     for (int c = 0; c < n; ++c) wheels.push_back(car.cornerName(c) + ".wheel");
-    SteadyStateSolver solver(car.getScene(), makeSteadyTurningProblem(car.getScene(), "chassis", wheels, 0.0));
+    SteadyStateSolver solver(car.getScene(), makeRestProblem(car.getScene(), "chassis", wheels, 0.0));
     SteadyStateResult r;
     try {
       r = solver.solve(car.makeInitialState(0.0));

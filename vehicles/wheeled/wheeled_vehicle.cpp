@@ -156,7 +156,7 @@ const FieldTable<WheeledVehicleParams>& WheeledVehicleParams::fields() {
                   "(each template's reduced form); dense: reduced, with every constraint row solved as one dense "
                   "system; auto: dense when every axle's template has a reduced form and the scene's rows are all "
                   "dense ones, else reduced, else constrained (the run's summary says which and why). Default: "
-                  "constrained");
+                  "auto");
   return t;
 }
 

@@ -51,6 +51,15 @@ SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::strin
   return p;
 }
 
+SteadyStateProblem makeRestProblem(const Scene& scene, const std::string& chassisBody,
+                                   const std::vector<std::string>& wheelBodies, double time_s) {
+  SteadyStateProblem p = makeSteadyTurningProblem(scene, chassisBody, wheelBodies, time_s);
+  p.checked_u = std::move(p.effective_u);  // yaw rate, horizontal velocity, spins: held at zero
+  p.effective_u.clear();
+  p.calc_steady_udot = nullptr;  // at rest every acceleration is zero
+  return p;
+}
+
 // ---------------------------------------------------------------------------
 SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem problem, SteadyStateOptions options)
     : scene_(scene), problem_(std::move(problem)), opt_(options) {
@@ -84,10 +93,21 @@ SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem prob
   ue_ = problem_.effective_u;
   std::sort(ue_.begin(), ue_.end());
   ue_.erase(std::unique(ue_.begin(), ue_.end()), ue_.end());
-  if (int(qe_.size() + ue_.size()) != nu_)
+  cu_ = problem_.checked_u;
+  std::sort(cu_.begin(), cu_.end());
+  cu_.erase(std::unique(cu_.begin(), cu_.end()), cu_.end());
+  for (int i : cu_) {
+    if (i < 0 || i >= nu_) throw Error("steady state: checked u index " + std::to_string(i) + " out of range");
+    if (contains(ue_, i))
+      throw Error("steady state: u index " + std::to_string(i) + " is both effective (solved) and checked (held at 0)");
+  }
+  for (int i = 0; i < nu_; ++i)
+    if (!contains(cu_, i)) fu_.push_back(i);
+  nf_ = int(fu_.size());
+  if (int(qe_.size() + ue_.size()) != nf_)
     throw Error("steady state: effective coordinates (" + std::to_string(qe_.size()) + ") plus effective speeds (" +
                 std::to_string(ue_.size()) + ") must equal the number of mobilities (" + std::to_string(nu_) +
-                ") so that unknowns and equations match");
+                ") less the checked ones (" + std::to_string(cu_.size()) + ") so that unknowns and equations match");
   np_ = int(problem_.parameters.size());
   if (int(problem_.conditions.size()) != np_)
     throw Error("steady state: " + std::to_string(np_) + " extra unknowns (parameters) but " +
@@ -98,7 +118,7 @@ SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem prob
   for (const auto& c : problem_.conditions)
     if (!c.calc || !(c.tolerance > 0) || !(c.weight > 0))
       throw Error("steady state: condition '" + c.name + "' needs calc, a positive tolerance and weight");
-  n_ = nu_ + m_ + nz_ + np_;
+  n_ = nf_ + m_ + nz_ + np_;
   for (const auto& p : problem_.parameters) curP_.push_back(p.get(se_));
   // Typical sizes of the unknowns (finite-difference steps) and weights that
   // bring every equation to newtons (merit and convergence report).
@@ -110,11 +130,11 @@ SteadyStateSolver::SteadyStateSolver(const Scene& scene, SteadyStateProblem prob
   for (int i = 0; i < nz_; ++i) xScale_[k++] = 1e-3;                  // tire lag states, m
   for (const auto& p : problem_.parameters) xScale_[k++] = p.typical;
   rScale_.resize(n_);
-  rScale_.head(nu_).setConstant(1.0);
-  rScale_.segment(nu_, mp_).setConstant(1e6);     // N per m of constraint error
-  rScale_.segment(nu_ + mp_, mv_).setConstant(1e4);  // N per m/s
-  rScale_.segment(nu_ + m_, nz_).setConstant(1e5);  // N per m/s of patch-deflection rate
-  for (int i = 0; i < np_; ++i) rScale_[nu_ + m_ + nz_ + i] = problem_.conditions[i].weight;
+  rScale_.head(nf_).setConstant(1.0);
+  rScale_.segment(nf_, mp_).setConstant(1e6);     // N per m of constraint error
+  rScale_.segment(nf_ + mp_, mv_).setConstant(1e4);  // N per m/s
+  rScale_.segment(nf_ + m_, nz_).setConstant(1e5);  // N per m/s of patch-deflection rate
+  for (int i = 0; i < np_; ++i) rScale_[nf_ + m_ + nz_ + i] = problem_.conditions[i].weight;
 }
 
 Eigen::VectorXd SteadyStateSolver::getUnknowns(const SimTK::State& se, const SimTK::Vector& lambda) const {
@@ -130,7 +150,7 @@ Eigen::VectorXd SteadyStateSolver::getUnknowns(const SimTK::State& se, const Sim
 
 Eigen::VectorXd SteadyStateSolver::getUnknowns(const SteadyStateResult& r) const {
   Eigen::VectorXd x = getUnknowns(r.euler_state, r.multipliers);
-  for (int i = 0; i < np_ && i < int(r.parameters.size()); ++i) x[nu_ + m_ + nz_ + i] = r.parameters[i];
+  for (int i = 0; i < np_ && i < int(r.parameters.size()); ++i) x[nf_ + m_ + nz_ + i] = r.parameters[i];
   return x;
 }
 
@@ -200,16 +220,18 @@ Eigen::VectorXd SteadyStateSolver::calcEquations(const Eigen::VectorXd& x) const
                                               residual);
   if (m_) {
     SimTK::Vector lambda(m_);
-    for (int i = 0; i < m_; ++i) lambda[i] = x[nu_ + i];
+    for (int i = 0; i < m_; ++i) lambda[i] = x[nf_ + i];
     matter.multiplyByGTranspose(se_, lambda, gtl);
     residual += gtl;  // M udot - f + G^T lambda (Simbody's sign)
   }
   Eigen::VectorXd r(n_);
-  for (int i = 0; i < nu_; ++i) r[i] = residual[i];
-  for (int i = 0; i < mp_; ++i) r[nu_ + i] = se_.getQErr()[i];
-  for (int i = 0; i < mv_; ++i) r[nu_ + mp_ + i] = se_.getUErr()[mp_ + i];
-  for (int i = 0; i < nz_; ++i) r[nu_ + m_ + i] = se_.getZDot()[i];
-  for (int i = 0; i < np_; ++i) r[nu_ + m_ + nz_ + i] = problem_.conditions[i].calc(se_);
+  for (int i = 0; i < nf_; ++i) r[i] = residual[fu_[i]];
+  checkedForces_.resize(int(cu_.size()));
+  for (std::size_t i = 0; i < cu_.size(); ++i) checkedForces_[i] = residual[cu_[i]];
+  for (int i = 0; i < mp_; ++i) r[nf_ + i] = se_.getQErr()[i];
+  for (int i = 0; i < mv_; ++i) r[nf_ + mp_ + i] = se_.getUErr()[mp_ + i];
+  for (int i = 0; i < nz_; ++i) r[nf_ + m_ + i] = se_.getZDot()[i];
+  for (int i = 0; i < np_; ++i) r[nf_ + m_ + nz_ + i] = problem_.conditions[i].calc(se_);
   return r;
 }
 
@@ -223,12 +245,12 @@ void SteadyStateSolver::calcJacobian(const Eigen::VectorXd& x, const Eigen::Vect
     e[j] = 1.0;
     scene_.getMatter().multiplyByGTranspose(se_, e, col);
     e[j] = 0.0;
-    J.col(nu_ + j).setZero();
-    for (int i = 0; i < nu_; ++i) J(i, nu_ + j) = col[i];
+    J.col(nf_ + j).setZero();
+    for (int i = 0; i < nf_; ++i) J(i, nf_ + j) = col[fu_[i]];
   }
   // The others by forward differences (3.16): step sqrt(eps) of the typical size.
   for (int j = 0; j < n_; ++j) {
-    if (j >= nu_ && j < nu_ + m_) continue;
+    if (j >= nf_ && j < nf_ + m_) continue;
     const double h = 1.5e-8 * std::max(std::abs(x[j]), xScale_[j]);
     Eigen::VectorXd xp = x;
     xp[j] += h;
@@ -238,6 +260,9 @@ void SteadyStateSolver::calcJacobian(const Eigen::VectorXd& x, const Eigen::Vect
 }
 
 std::string SteadyStateSolver::describeEquation(int row) const {
+  if (row < 0) row = cu_[-1 - row];  // checked equation -1 - k
+  else if (row < nf_) row = fu_[row];
+  else row += nu_ - nf_;
   if (row < nu_) {
     const SimTK::SimbodyMatterSubsystem& matter = scene_.getMatter();
     for (SimTK::MobilizedBodyIndex b(0); b < matter.getNumBodies(); ++b) {
@@ -298,18 +323,18 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
 
   SteadyStateResult res;
   Eigen::VectorXd x = getUnknowns(se_, lambda0);
-  for (int i = 0; i < np_; ++i) x[nu_ + m_ + nz_ + i] = p0[i];
+  for (int i = 0; i < np_; ++i) x[nf_ + m_ + nz_ + i] = p0[i];
   Eigen::VectorXd r = calcEquations(x);
   auto merit = [&](const Eigen::VectorXd& rr) { return rr.cwiseProduct(rScale_).norm(); };
   auto blocks = [&](const Eigen::VectorXd& rr, double& f, double& p, double& v, double& z) {
-    f = maxAbs(rr.head(nu_));
-    p = maxAbs(rr.segment(nu_, mp_));
-    v = maxAbs(rr.segment(nu_ + mp_, mv_));
-    z = maxAbs(rr.segment(nu_ + m_, nz_));
+    f = maxAbs(rr.head(nf_));
+    p = maxAbs(rr.segment(nf_, mp_));
+    v = maxAbs(rr.segment(nf_ + mp_, mv_));
+    z = maxAbs(rr.segment(nf_ + m_, nz_));
   };
   auto conditionsMet = [&](const Eigen::VectorXd& rr) {
     for (int i = 0; i < np_; ++i)
-      if (!(std::abs(rr[nu_ + m_ + nz_ + i]) <= problem_.conditions[i].tolerance)) return false;
+      if (!(std::abs(rr[nf_ + m_ + nz_ + i]) <= problem_.conditions[i].tolerance)) return false;
     return true;
   };
   auto converged = [&](const Eigen::VectorXd& rr) {
@@ -425,7 +450,7 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
     block("max zdot", res.rate_residual, opt_.rate_tolerance, "");
     // The extra conditions are part of convergence too (conditionsMet): each named.
     for (int i = 0; i < np_; ++i)
-      block(("condition '" + problem_.conditions[i].name + "'").c_str(), std::abs(r[nu_ + m_ + nz_ + i]),
+      block(("condition '" + problem_.conditions[i].name + "'").c_str(), std::abs(r[nf_ + m_ + nz_ + i]),
             problem_.conditions[i].tolerance, "");
     throw SteadyStateError(
         std::string("steady state did not converge") + (stalled ? " (no descent along the Newton direction)" : "") +
@@ -433,30 +458,46 @@ SteadyStateResult SteadyStateSolver::solveFrom(SimTK::State se, const SimTK::Vec
         "; worst equation (scaled): " + describeEquation(int(worst)) + " = " + formatValue(r[worst]) +
         " (no steady state may exist here: beyond the limit of adhesion or past a fold of the branch)");
   }
+  if (!cu_.empty()) {
+    // The checked equations have no unknown: at the solution they vanish on
+    // their own (a vehicle at rest on a flat road: no tire in-plane force at
+    // zero slip) or the problem has no solution with those speeds held at 0.
+    r = calcEquations(x);  // sets checkedForces_ at x (evaluations are pure: r is unchanged)
+    res.residual_evaluations = evaluations_;
+    Eigen::Index worst = 0;
+    const double f = checkedForces_.cwiseAbs().maxCoeff(&worst);
+    if (!(f <= opt_.force_tolerance))
+      throw SteadyStateError("steady state: the solved equations converged in " + std::to_string(res.iterations) +
+                             " iterations, but " + describeEquation(-1 - int(worst)) + " = " +
+                             formatValue(checkedForces_[worst]) + " N (tolerance " + formatValue(opt_.force_tolerance) +
+                             " N): that mobility's speed is held at zero and its equation is checked, not solved "
+                             "(SteadyStateProblem::checked_u); a vehicle at rest needs no tire in-plane force at zero "
+                             "slip (a tire with camber thrust, conicity or ply steer at rest creeps)");
+  }
   fillResult(x, r, res);
   res.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return res;
 }
 
 bool SteadyStateSolver::meetsTolerances(const Eigen::VectorXd& r) const {
-  if (maxAbs(r.head(nu_)) > opt_.force_tolerance || maxAbs(r.segment(nu_, mp_)) > opt_.position_tolerance ||
-      maxAbs(r.segment(nu_ + mp_, mv_)) > opt_.velocity_tolerance || maxAbs(r.segment(nu_ + m_, nz_)) > opt_.rate_tolerance)
+  if (maxAbs(r.head(nf_)) > opt_.force_tolerance || maxAbs(r.segment(nf_, mp_)) > opt_.position_tolerance ||
+      maxAbs(r.segment(nf_ + mp_, mv_)) > opt_.velocity_tolerance || maxAbs(r.segment(nf_ + m_, nz_)) > opt_.rate_tolerance)
     return false;
   for (int i = 0; i < np_; ++i)
-    if (!(std::abs(r[nu_ + m_ + nz_ + i]) <= problem_.conditions[i].tolerance)) return false;
+    if (!(std::abs(r[nf_ + m_ + nz_ + i]) <= problem_.conditions[i].tolerance)) return false;
   return r.allFinite();
 }
 
 void SteadyStateSolver::fillResult(const Eigen::VectorXd& x, const Eigen::VectorXd& r, SteadyStateResult& res) const {
-  res.force_residual = maxAbs(r.head(nu_));
-  res.position_error = maxAbs(r.segment(nu_, mp_));
-  res.velocity_error = maxAbs(r.segment(nu_ + mp_, mv_));
-  res.rate_residual = maxAbs(r.segment(nu_ + m_, nz_));
+  res.force_residual = std::max(maxAbs(r.head(nf_)), maxAbs(checkedForces_));
+  res.position_error = maxAbs(r.segment(nf_, mp_));
+  res.velocity_error = maxAbs(r.segment(nf_ + mp_, mv_));
+  res.rate_residual = maxAbs(r.segment(nf_ + m_, nz_));
   res.residual_norm = r.cwiseProduct(rScale_).norm();
   res.condition_residual = maxAbs(r.tail(np_));
   res.multipliers.resize(m_);
-  for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nu_ + i];
-  res.parameters.assign(x.data() + nu_ + m_ + nz_, x.data() + n_);
+  for (int i = 0; i < m_; ++i) res.multipliers[i] = x[nf_ + i];
+  res.parameters.assign(x.data() + nf_ + m_ + nz_, x.data() + n_);
   res.euler_state = se_;
   res.state = toQuaternions(scene_, se_);
   scene_.getSystem().realize(res.state, SimTK::Stage::Velocity);
@@ -466,6 +507,9 @@ void SteadyStateSolver::fillResult(const Eigen::VectorXd& x, const Eigen::Vector
 void SteadyStateSolver::beginDriven(const SteadyStateResult& start, std::function<void(SimTK::State&, double)> drive,
                                     double lambda_scale) {
   if (!drive) throw Error("steady state continuation: no driving condition");
+  if (!cu_.empty())
+    throw Error("steady state continuation: the problem has checked equations (SteadyStateProblem::checked_u, a "
+                "static equilibrium at rest); continuation solves steady motions only");
   requirePositive(lambda_scale, "steady state continuation: typical size of the driving condition");
   SimTK::State se = start.euler_state;
   se.setTime(problem_.time_s);

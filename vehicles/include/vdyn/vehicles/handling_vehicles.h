@@ -101,7 +101,7 @@ struct VehicleReport {
 /// The report of a scene's vehicle (fourws, quarter_car), on the built scene
 /// with its plugins. 4WS: the steering held at zero (the scene's steering and
 /// controllers replaced, no speed hold), static equilibrium by the steady-state
-/// solver at zero speed (unknowns q, u, lambda; the speeds solve to zero),
+/// solver's makeRestProblem (unknowns q, lambda; every speed held at zero),
 /// kinematics of the RF and RR corners over `travels_m`. Quarter car:
 /// solveStaticEquilibrium (its initial state), kinematics of its corner.
 VehicleReport makeVehicleReport(const SceneDescription& scene, const std::vector<double>& travels_m);

@@ -95,15 +95,14 @@ struct WheeledVehicleParams {
   ///   "auto": dense when every axle's template has a reduced form and the
   ///     scene's rows are all ones the dense system solves, reduced when only
   ///     the templates allow it, else constrained.
-  /// The default stays "constrained" until the static and steady-state
-  /// solvers hold on reduced states (with "auto" as default, 7 tests of
-  /// static equilibrium, ride height and steady turns fail to converge:
-  /// issue 24, left open).
+  /// The default is "auto" (issue 24): the framework picks the fast form the
+  /// templates allow; "constrained" is the reference (tests/test_formulation.cpp
+  /// holds the chapter scenes within their stated accuracy both ways).
   /// The axles' "template" keys name the mechanism; this key picks its form
   /// (double_wishbone and double_wishbone_reduced are two forms of one).
   /// getFormulation() says which ran and why. makeInitialState and
   /// makeStateLike return states of that formulation.
-  std::string formulation = "constrained";
+  std::string formulation = "auto";
   /// Data key "spring_free_length_from_ride_height" (default false; the
   /// quarter car's key): true sets every corner spring's free length (its
   /// suspension block's spring.free_length_m, and its "left" block's) so that
@@ -134,7 +133,7 @@ struct WheeledVehicleParams {
   };
   /// A copy with spring_free_length_from_ride_height false and every spring's
   /// free length set for the design ride height (see the key): a fixed point on
-  /// the vehicle's static equilibrium (the steady-state solver at zero speed,
+  /// the vehicle's static equilibrium (the steady-state solver's makeRestProblem,
   /// steerable axles held straight), l0 <- l0 + (L_design - l_rest), until the
   /// rest lengths are within 1e-9 m of design (each axle whose left corner is
   /// the mirror keeps one free length: the mean of its sides' updates). An axle

@@ -67,6 +67,13 @@ struct SteadyStateProblem {
   std::vector<int> ineffective_q;
   /// Effective generalized speeds (unknowns); every other u is a zero variable.
   std::vector<int> effective_u;
+  /// Mobilities whose equations are checked at the solution, not solved:
+  /// a static equilibrium (makeRestProblem) holds every speed at zero, so the
+  /// ineffective coordinates (chassis x, y, yaw, wheel spins) have no unknown
+  /// left; their generalized forces (the tires' in-plane forces at zero slip)
+  /// must vanish on their own, to the force tolerance, or solve() throws
+  /// naming the equation. u indices; effective q + effective u + these = nu.
+  std::vector<int> checked_u;
   /// Steady accelerations udot_s(q, u) (3.19), given Stage::Velocity; all zero
   /// when empty.
   std::function<void(const SimTK::State&, SimTK::Vector& udot)> calc_steady_udot;
@@ -90,6 +97,16 @@ struct SteadyStateProblem {
 /// every other speed zero; chassis acceleration w x v (3.19).
 SteadyStateProblem makeSteadyTurningProblem(const Scene& scene, const std::string& chassisBody,
                                             const std::vector<std::string>& wheelBodies, double time_s);
+
+/// The static equilibrium at rest of the same vehicle: every speed held at
+/// zero (zero variables), the coordinates other than the chassis x, y, yaw and
+/// the wheel spin angles solved (and the constraint multipliers); the
+/// equations of those ineffective coordinates are checked, not solved
+/// (SteadyStateProblem::checked_u). As a steady turn at zero speed the speeds
+/// were unknowns too, and free rolling (chassis x velocity U, every wheel
+/// spin U / R) solved them at any U: a singular Jacobian.
+SteadyStateProblem makeRestProblem(const Scene& scene, const std::string& chassisBody,
+                                   const std::vector<std::string>& wheelBodies, double time_s);
 
 struct SteadyStateOptions {
   double force_tolerance = 1e-6;       ///< max |generalized-force residual|, N or N m
@@ -123,7 +140,7 @@ struct SteadyStateResult {
   int iterations = 0;              ///< Newton iterations
   int jacobians = 0;               ///< finite-difference Jacobians taken
   int residual_evaluations = 0;
-  double force_residual = 0;       ///< max |f - M udot_s - G^T lambda|, N
+  double force_residual = 0;       ///< max |f - M udot_s - G^T lambda|, N (checked equations included)
   double position_error = 0;       ///< max |Psi|
   double velocity_error = 0;       ///< max |nonholonomic error|
   double rate_residual = 0;        ///< max |zdot|
@@ -249,6 +266,9 @@ class SteadyStateSolver {
   SteadyStateOptions opt_;
   std::vector<int> qAll_;     // q indices in use (Euler state)
   std::vector<int> qe_, ue_;  // effective q and u (Euler state)
+  std::vector<int> fu_, cu_;  // mobilities whose force equations are solved / checked (u indices)
+  mutable Eigen::VectorXd checkedForces_;  // the checked force equations at the last calcEquations
+  int nf_ = 0;                // solved force equations (= effective q + effective u)
   int nq_ = 0, nu_ = 0, nz_ = 0, mp_ = 0, mv_ = 0, m_ = 0, np_ = 0, n_ = 0;
   mutable std::vector<double> curP_;  // parameter values the model holds now
   mutable double lastEquilibriumResidual_ = 0;  // max |reduced rate| at the last linearisation point
