@@ -182,8 +182,10 @@ TEST(QuarterCar, AppAFreeLengthHasNoRestPoseInBump) {
   // pose exists in bump. Independent of the full solve, hold the lower arm at
   // each angle from the tabulated one to 70 deg into bump (1 deg steps), solve
   // the rest, and read the arm's imbalance: it stays above 50 N m, with its
-  // minimum (a fold: the spring's line turns towards the arm pivot and its
-  // moment stops growing) near 35 deg.
+  // minimum (a fold) near 35 deg. The spring's moment grows to about 42 deg; the
+  // imbalance stops falling because the wheel load's moment grows too: the thin
+  // disc's contact moves outboard with the camber gained in bump (test
+  // AppAFreeLengthRestsWhenTheContactStaysUnderTheWheelCentre).
   const QuarterCarParams p = appAFreeLength(false);
   ASSERT_DOUBLE_EQ(p.corner.spring_free_length_m, 0.344);
   const QuarterCar car(p);
@@ -239,8 +241,8 @@ TEST(QuarterCar, AppAFreeLengthHasNoRestPoseInBump) {
 
 TEST(QuarterCar, DeepBumpRestPoseMatchesADampedTransient) {
   // Free length 0.360 m (1.6 cm above App. A's, 0.5 cm past the fold at about
-  // 0.355 m where the bump rest pose appears): the rest pose is deep in bump,
-  // near the independent corner model's (13.4 cm lower, arm ~25 deg). The
+  // 0.355 m where the bump rest pose appears): the rest pose is deep in bump
+  // (13.2 cm lower, arm 26.5 deg). The
   // static equilibrium and the scene's own dynamics (the real damper,
   // frictionless tire, from the tabulated pose, 10 s) agree to 1e-8.
   QuarterCarParams p = appAFreeLength(true);
@@ -287,4 +289,95 @@ TEST(QuarterCar, DeepBumpRestPoseMatchesADampedTransient) {
   EXPECT_LE(rf.constraint_error, 1e-12);
   EXPECT_NEAR(car.chassis().getOneQ(f, 0), car.chassis().getOneQ(e, 0), 1e-9);
   EXPECT_NEAR(arm.getOneQ(f, 0), arm.getOneQ(e, 0), 1e-9);
+}
+
+TEST(QuarterCar, AppAFreeLengthRestsWhenTheContactStaysUnderTheWheelCentre) {
+  // Why the independent corner model (issue 22) finds a rest pose with App. A's
+  // 0.344 m and ours does not. The spring is App. A's (Table A.3: chassis (1) point
+  // (1.31, -0.395, -0.10) m to the lower arm's (2) origin, l0 0.344 m; K = 40e3 N/m
+  // from section 4.6.4): its moment about the lower pivot, computed here by hand from
+  // the points, is the model's. What differs is the wheel load's moment: this linkage
+  // gains 12.0 deg of camber at 25 deg of bump (19.1 deg at 35), and the thin disc's
+  // contact (carcass_radius_m 0, App. A's torus has no stated tube radius) moves
+  // R0 sin(gamma) outboard of the wheel centre, 6.2 cm at 25 deg: the load's moment
+  // grows with bump (549 -> 604 -> 641 N m at 0, 25, 35 deg) faster than the
+  // spring's. With the contact under the wheel centre (a torus whose tube fills the
+  // wheel: rc = 0.2999 m, the contact 0.1 mm sin(gamma) off) the load's moment falls
+  // with bump and the corner rests 25.5 deg into bump, the independent model's pose.
+  QuarterCarParams thin = appAFreeLength(true);
+  const QuarterCar disc(thin);
+  SimTK::State s = disc.makeInitialState(false);
+  const auto armD = disc.corner().lower_arm;
+  const double q0 = armD.getOneQ(s, 0);
+  const auto& cp = disc.params().corner;
+  // Held 25 deg into bump (1 deg steps from the tabulated pose: a jump lifts the tire).
+  double imbDisc = 0;
+  for (int k = 0; k <= 25; ++k) imbDisc = armImbalance(disc, s, q0 - k * M_PI / 180);
+  const double q25 = q0 - 25 * M_PI / 180;
+  // Closed form: the pivot axis is x through P; the arm's origin sits at -child_point
+  // from the pivot in the arm frame, turned by q about x.
+  const SimTK::Vec3 P = cp.lower_pivot.parent_point_m, rA = -cp.lower_pivot.child_point_m;
+  const SimTK::Vec3 r(0, rA[1] * std::cos(q25) - rA[2] * std::sin(q25), rA[1] * std::sin(q25) + rA[2] * std::cos(q25));
+  const SimTK::Vec3 d = (cp.spring_chassis_point_m - P) - r;  // arm point to chassis point
+  const double l = d.norm(), F = cp.spring_stiffness_N_per_m * (cp.spring_free_length_m - l);  // compression force
+  const SimTK::Vec3 F_A = -F * d / l;  // on the arm, away from the chassis point
+  const double M_hand = r[1] * F_A[2] - r[2] * F_A[1];  // about +x (+ drives the arm to rebound)
+  disc.getScene().getSystem().realize(s, SimTK::Stage::Position);
+  const double l_model = (disc.chassis().findStationLocationInGround(s, cp.spring_chassis_point_m) -
+                          armD.findStationLocationInGround(s, cp.spring_arm_point_m)).norm();
+  auto lengthAt = [&](double q) {
+    SimTK::State t = s;
+    armD.setOneQ(t, 0, q);
+    disc.getScene().getSystem().realize(t, SimTK::Stage::Position);
+    return (disc.chassis().findStationLocationInGround(t, cp.spring_chassis_point_m) -
+            armD.findStationLocationInGround(t, cp.spring_arm_point_m)).norm();
+  };
+  const double M_model = -cp.spring_stiffness_N_per_m * (l_model - cp.spring_free_length_m) *
+                         (lengthAt(q25 + 1e-6) - lengthAt(q25 - 1e-6)) / 2e-6;
+  disc.getScene().getSystem().realize(s, SimTK::Stage::Velocity);
+  const TireContact c = disc.tire().calcContact(s);
+  const double gamma = c.kinematics.camber_rad;
+  const double dy = c.p_GC[1] - disc.corner().wheel.getBodyOriginLocation(s)[1];
+  std::printf("25 deg bump, thin disc: spring length %.6f m (hand %.6f), force %.2f N, moment %.4f N m (hand %.4f); "
+              "camber %.3f deg, contact %.4f m outboard of the wheel centre (R0 sin gamma %.4f); arm imbalance %.2f N m, "
+              "so the load's moment is %.2f N m\n",
+              l_model, l, F, M_model, M_hand, gamma * 180 / M_PI, -dy, 0.30 * std::sin(gamma), imbDisc,
+              imbDisc + M_model);
+  EXPECT_NEAR(l_model, l, 1e-12);
+  EXPECT_NEAR(M_model, M_hand, 1e-6);
+  EXPECT_NEAR(M_hand, 510.0, 0.1);
+  EXPECT_NEAR(-dy, 0.30 * std::sin(gamma), 1e-3);  // deflection 1.5 cm along the tilted plane: < 1 mm
+  EXPECT_GT(imbDisc, 90.0);  // short of the load by > 90 N m
+
+  // The contact under the wheel centre: static equilibrium from the tabulated pose,
+  // and a damped frictionless transient from it, at the same pose within 1e-8.
+  QuarterCarParams under = appAFreeLength(true);
+  under.tire.params["carcass_radius_m"] = 0.2999;
+  const QuarterCar car(under);
+  const auto arm = car.corner().lower_arm;
+  const Scene& sc = car.getScene();
+  const SimTK::State tab = car.makeInitialState(false);
+  SimTK::State e = tab;
+  const auto res = solveStaticEquilibrium(sc, e, car.ineffectiveMobilizers());
+  EXPECT_LE(res.force_residual, 1e-6);
+  sc.getSystem().realize(e, SimTK::Stage::Acceleration);
+  const double W = car.totalMass() * car.params().gravity_m_per_s2;
+  SimTK::State tr = tab;
+  SimulationSettings sim;
+  sim.t_end_s = 10.0;
+  sim.integrator.accuracy = 1e-10;
+  simulate(sc, tr, sim);
+  const double bump_deg = (arm.getOneQ(tab, 0) - arm.getOneQ(e, 0)) * 180 / M_PI;
+  std::printf("contact under the wheel centre, free length 0.344 m: rest pose chassis z %.10f m (%.4f m below the "
+              "tabulated %.6f), lower arm %.10f rad (%.3f deg of bump), tire load %.6f N (weight %.6f N), %d Newton + %d "
+              "Levenberg-Marquardt iterations; transient at 10 s: z %.10f, arm %.10f, |u| %.2e\n",
+              car.chassis().getOneQ(e, 0), car.chassis().getOneQ(tab, 0) - car.chassis().getOneQ(e, 0),
+              car.chassis().getOneQ(tab, 0), arm.getOneQ(e, 0), bump_deg, sc.evalOutput("tire.Fz_N", e), W,
+              res.newton_iterations, res.trust_region_iterations, car.chassis().getOneQ(tr, 0), arm.getOneQ(tr, 0),
+              tr.getU().normInf());
+  EXPECT_NEAR(sc.evalOutput("tire.Fz_N", e), W, 1e-6);
+  EXPECT_NEAR(bump_deg, 25.5, 0.5);
+  EXPECT_NEAR(car.chassis().getOneQ(tr, 0), car.chassis().getOneQ(e, 0), 1e-8);
+  EXPECT_NEAR(arm.getOneQ(tr, 0), arm.getOneQ(e, 0), 1e-8);
+  EXPECT_LT(tr.getU().normInf(), 1e-6);
 }

@@ -12,6 +12,7 @@
 #include <thread>
 
 #include "vdyn/core/key_path.h"
+#include "vdyn/core/named_outcome.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 
@@ -210,6 +211,62 @@ TEST(SweepRunner, MissingSummaryQuantityFailsTheRowNamingIt) {
   EXPECT_FALSE(r.rows[0].ok);
   EXPECT_EQ(r.rows[0].reason.substr(0, 47), "collect: the run's summary has no 'not_there' (");
   EXPECT_EQ(r.failed, d.variations.size());
+}
+
+TEST(SweepRunner, NamedOutcomesAreRowsOfTheirOwnStatusNotFailures) {
+  // A run that throws a NamedOutcome (e.g. a steady state past the fold of the
+  // branch from straight running) is a row of that status in results.csv,
+  // results.json, the journal and the counts, apart from the failed ones;
+  // --retry-failed does not run it again.
+  const SweepDescription d = syntheticSweep();
+  const std::string dir = tempDir("named");
+  std::atomic<int> calls{0};
+  const SweepRunFunction run = [&](const SweepDescription& dd, const Variation& v) {
+    ++calls;
+    const double x = v.find("a.x")->get<double>();
+    if (x > 0.9) throw NamedOutcome("beyond_fold", "no steady state on the branch: fold at " + formatValue(x));
+    if (v.index == 2) throw NamedOutcome("past_lift_off", "past a wheel lift-off");
+    return synthetic(dd, v);
+  };
+  SweepOptions o;
+  o.out_dir = dir;
+  o.threads = 2;
+  const SweepResult r = runSweep(d, run, o);
+  EXPECT_EQ(calls, 16);
+  EXPECT_EQ(r.failed, 1u);  // row 14, the synthetic failure
+  ASSERT_EQ(r.outcomes.size(), 2u);
+  EXPECT_EQ(r.outcomes.at("beyond_fold"), 2u);  // a.x = 1.0 at n = 2000 and 20000
+  EXPECT_EQ(r.outcomes.at("past_lift_off"), 1u);
+  EXPECT_EQ(sweepStatus(r.rows[12]), "beyond_fold");
+  EXPECT_EQ(sweepStatus(r.rows[14]), "failed");
+  EXPECT_EQ(sweepStatus(r.rows[0]), "ok");
+  const std::string csv = readFile(dir + "/results.csv");
+  EXPECT_NE(csv.find("\n12,beyond_fold,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find(",2000,,,,,,,no steady state on the branch: fold at "), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n2,past_lift_off,"), std::string::npos) << csv;
+  EXPECT_NE(csv.find("\n14,failed,"), std::string::npos) << csv;
+  const Json results = Json::parse(readFile(dir + "/results.json"));
+  EXPECT_EQ(results["runs"][13]["status"], "beyond_fold");
+  EXPECT_EQ(results["runs"][14]["status"], "failed");
+  const Json stats = Json::parse(readFile(dir + "/sweep_stats.json"));
+  EXPECT_EQ(stats["failed"], 1);
+  EXPECT_EQ(stats["outcomes"], Json({{"beyond_fold", 2}, {"past_lift_off", 1}}));
+  // Resumed from the journal: the same statuses; --retry-failed reruns row 14 only.
+  calls = 0;
+  o.retry_failed = true;
+  const SweepResult again = runSweep(d, run, o);
+  EXPECT_EQ(calls, 1);
+  EXPECT_EQ(again.failed, 1u);
+  EXPECT_EQ(again.outcomes, r.outcomes);
+  EXPECT_EQ(readFile(dir + "/results.csv"), csv);
+  // The progress line counts them apart.
+  SweepProgress p;
+  p.total = 16, p.done = 16, p.failed = 1, p.outcomes = {{"beyond_fold", 2}};
+  testing::internal::CaptureStderr();
+  sweepProgressPrinter("t")(p);
+  EXPECT_NE(testing::internal::GetCapturedStderr().find("16/16 runs (1 failed, 2 beyond_fold)"), std::string::npos);
+  EXPECT_NE(errorOf([] { NamedOutcome("beyond", "x"); }).find("unknown status 'beyond'"), std::string::npos);
+  std::filesystem::remove_all(dir);
 }
 
 TEST(SweepRunner, ResumeSkipsRunsInTheJournal) {

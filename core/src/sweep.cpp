@@ -2,6 +2,7 @@
 
 #include "vdyn/core/interrupt.h"
 #include "vdyn/core/key_path.h"
+#include "vdyn/core/named_outcome.h"
 #include "vdyn/core/scene_file.h"
 
 #include <algorithm>
@@ -539,6 +540,10 @@ SweepRunFunction makeSceneSweepRun(const SweepDescription& d, PluginRegistry& re
   };
 }
 
+std::string sweepStatus(const SweepRow& row) {
+  return row.ok ? "ok" : row.outcome.empty() ? "failed" : row.outcome;
+}
+
 SweepRow runVariation(const SweepDescription& d, const Variation& v, const SweepRunFunction& run) {
   SweepRow row;
   row.index = v.index;
@@ -551,6 +556,7 @@ SweepRow runVariation(const SweepDescription& d, const Variation& v, const Sweep
     row.ok = true;
   } catch (const std::exception& e) {
     row.ok = false;
+    if (const auto* named = dynamic_cast<const NamedOutcome*>(&e)) row.outcome = named->status();
     row.reason = e.what();
     for (char& c : row.reason)
       if (c == '\n' || c == '\r') c = ' ';
@@ -564,12 +570,12 @@ SweepRow runVariation(const SweepDescription& d, const Variation& v, const Sweep
 
 // --- journal ----------------------------------------------------------------------
 std::string sweepJournalLine(const SweepDescription& d, const SweepRow& row) {
-  // "run": the run function's outcome; a row failed only by collection keeps
-  // its summary and is re-collected on resume.
+  // "run": the run function's outcome (ok, a named outcome or failed); a row
+  // failed only by collection keeps its summary and is re-collected on resume.
   const bool ranOk = !row.summary.is_null();
   Json j = {{"variation", row.index},
             {"id", d.variations.at(row.index).id()},
-            {"run", ranOk ? "ok" : "failed"},
+            {"run", ranOk ? "ok" : row.outcome.empty() ? "failed" : row.outcome},
             {"wall_s", row.wall_s},
             {"cpu_s", row.cpu_s}};
   if (ranOk) j["summary"] = row.summary;
@@ -604,6 +610,7 @@ SweepRow parseSweepJournalLine(const SweepDescription& d, const std::string& lin
     row.summary = j.value("summary", Json());
   } else {
     row.ok = false;
+    if (j["run"].is_string() && isNamedOutcomeStatus(j["run"].get<std::string>())) row.outcome = j["run"].get<std::string>();
     row.reason = j.value("reason", std::string("(no reason recorded)"));
   }
   collectValues(d, row);
@@ -671,7 +678,7 @@ std::string formatSweepCsv(const SweepDescription& d, const std::vector<SweepRow
   s += ",reason\n";
   for (const SweepRow& r : rows) {
     const Variation& v = d.variations.at(r.index);
-    s += std::to_string(r.index) + (r.ok ? ",ok" : ",failed");
+    s += std::to_string(r.index) + "," + sweepStatus(r);
     for (const auto& k : d.keys) {
       const Json* x = v.find(k);
       s += "," + (x ? formatSweepField(*x) : std::string());
@@ -689,7 +696,7 @@ std::string formatSweepJson(const SweepDescription& d, const std::vector<SweepRo
     Json set = Json::object(), values = Json::object();
     for (const auto& st : d.variations.at(r.index).settings) set[st.key] = st.value;
     for (std::size_t k = 0; k < d.collect.size(); ++k) values[d.collect[k]] = k < r.values.size() ? r.values[k] : Json();
-    Json row = {{"variation", r.index}, {"status", r.ok ? "ok" : "failed"}, {"set", set}, {"values", values}};
+    Json row = {{"variation", r.index}, {"status", sweepStatus(r)}, {"set", set}, {"values", values}};
     if (!r.ok) row["reason"] = r.reason;
     runs.push_back(std::move(row));
   }
@@ -727,6 +734,7 @@ void writeSweepOutputs(const SweepDescription& d, const SweepResult& r, const st
                 {"variations", d.variations.size()},
                 {"ran", r.ran},
                 {"failed", r.failed},
+                {"outcomes", r.outcomes},
                 {"resumed", r.resumed},
                 {"partial", r.partial},
                 {"wall_s", r.wall_s},
@@ -755,10 +763,12 @@ std::function<void(const SweepProgress&)> sweepProgressPrinter(const std::string
     *last = p.elapsed_s;
     char eta[64] = "";
     if (!end && p.eta_s >= 0) std::snprintf(eta, sizeof eta, ", about %.0f s left", p.eta_s);
+    std::string named;
+    for (const auto& [status, count] : p.outcomes) named += ", " + std::to_string(count) + " " + status;
     char skipped[64] = "";
     if (p.skipped) std::snprintf(skipped, sizeof skipped, ", %zu from the journal", p.skipped);
-    std::fprintf(stderr, "%s%s: %zu/%zu runs (%zu failed%s), %.1f s%s%s", tty ? "\r\033[K" : "", label.c_str(),
-                 finished, p.total, p.failed, skipped, p.elapsed_s, eta, tty && !end ? "" : "\n");
+    std::fprintf(stderr, "%s%s: %zu/%zu runs (%zu failed%s%s), %.1f s%s%s", tty ? "\r\033[K" : "", label.c_str(),
+                 finished, p.total, p.failed, named.c_str(), skipped, p.elapsed_s, eta, tty && !end ? "" : "\n");
     std::fflush(stderr);
   };
 }
@@ -775,7 +785,7 @@ std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepO
     if (ec) throw Error("cannot create output folder '" + o.out_dir + "': " + ec.message());
     if (o.resume) {
       for (SweepRow& r : readSweepJournal(d, o.out_dir)) {
-        if (!r.ok && o.retry_failed) continue;
+        if (sweepStatus(r) == "failed" && o.retry_failed) continue;
         have[r.index] = 1;
         res.rows[r.index] = std::move(r);
         ++res.resumed;
@@ -791,8 +801,10 @@ std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepO
 
 void finishSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
                     std::chrono::steady_clock::time_point start, double cpu0) {
-  for (const auto& r : res.rows)
-    if (!r.ok) ++res.failed;
+  for (const auto& r : res.rows) {
+    if (sweepStatus(r) == "failed") ++res.failed;
+    if (!r.outcome.empty()) ++res.outcomes[r.outcome];
+  }
   res.wall_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   res.cpu_s = processCpuSeconds() - cpu0;
   if (!o.out_dir.empty()) writeSweepOutputs(d, res, o.out_dir);
@@ -829,7 +841,8 @@ SweepResult runSweep(const SweepDescription& d, const SweepRunFunction& run, con
       }
     }
     ++prog.done;
-    if (!row.ok) ++prog.failed;
+    if (sweepStatus(row) == "failed") ++prog.failed;
+    if (!row.outcome.empty()) ++prog.outcomes[row.outcome];
     res.rows[row.index] = std::move(row);
     prog.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     prog.eta_s = prog.elapsed_s / prog.done * double(pending.size() - prog.done);

@@ -112,7 +112,8 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   auto record = [&](SweepRow&& row) {  // manager thread only
     if (journal) journal->appendLine(sweepJournalLine(d, row));
     ++prog.done;
-    if (!row.ok) ++prog.failed;
+    if (sweepStatus(row) == "failed") ++prog.failed;
+    if (!row.outcome.empty()) ++prog.outcomes[row.outcome];
     res.rows[row.index] = std::move(row);
     prog.elapsed_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     prog.eta_s = prog.elapsed_s / prog.done * double(pendingCount - prog.done);

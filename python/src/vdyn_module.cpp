@@ -219,14 +219,16 @@ py::dict sweep(py::handle sweepFile, int threads, const std::string& out, const 
   }
   py::dict rows;
   std::vector<double> index;
-  py::list ok, reason;
+  py::list ok, status, reason;
   for (const auto& row : r.rows) {
     index.push_back(double(row.index));
     ok.append(row.ok);
+    status.append(vdyn::sweepStatus(row));
     reason.append(row.reason);
   }
   rows["variation"] = py::array(py::module_::import("numpy").attr("array")(toArray(index), py::arg("dtype") = "int64"));
   rows["ok"] = py::array(py::module_::import("numpy").attr("array")(ok, py::arg("dtype") = "bool"));
+  rows["status"] = py::array(py::module_::import("numpy").attr("array")(status, py::arg("dtype") = "object"));
   for (const auto& key : d.keys) {
     std::vector<Json> v;
     for (const auto& row : r.rows) {

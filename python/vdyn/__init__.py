@@ -54,8 +54,9 @@ def list():  # noqa: A001 (the CLI's name: vdyn list)
 def sweep(sweep, threads=1, out=None, base_dir=None):
     """Run a sweep (a sweep file's path, or its JSON as a dict) on ``threads``
     C++ threads (GIL released); returns the rows, ordered by variation, as a
-    dict of NumPy arrays: "variation", "ok", every varied key, every collected
-    summary path (NaN where a run failed) and "reason". With ``out`` the CLI's
+    dict of NumPy arrays: "variation", "ok", "status" (results.csv's: "ok",
+    a named outcome such as "beyond_fold", or "failed"), every varied key, every
+    collected summary path (NaN where a run has no result) and "reason". With ``out`` the CLI's
     files (results.csv, results.json, runs.jsonl) are written there too. A
     dict's "scene" resolves from ``base_dir`` (default: the working folder),
     then along the data search path. ``pandas.DataFrame(rows)`` makes a table."""

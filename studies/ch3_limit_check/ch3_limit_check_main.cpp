@@ -27,6 +27,7 @@
 #include "study.h"
 #include "vdyn/core/error.h"
 #include "vdyn/core/file_io.h"
+#include "vdyn/core/named_outcome.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 #include "vdyn/vehicles/standard_registry.h"
@@ -102,7 +103,15 @@ int main(int argc, char** argv) {
     // limit (fewer where one kind has fewer), each spread evenly over its rows.
     const std::size_t n = d.variations.size();
     std::vector<std::size_t> steadyRows, pastRows;
-    for (std::size_t i = 0; i < n; ++i) (runs.at(i).at("status") == "ok" ? steadyRows : pastRows).push_back(i);
+    // A row is a steady state ("ok") or past the limit (a named outcome:
+    // beyond_fold, past_lift_off); a failed row has nothing to check against.
+    for (std::size_t i = 0; i < n; ++i) {
+      const std::string status = runs.at(i).at("status").get<std::string>();
+      if (status != "ok" && !isNamedOutcomeStatus(status))
+        throw Error(resultsFile + ": row " + std::to_string(i) + " is '" + status + "' (" +
+                    runs.at(i).value("reason", std::string()) + "): neither a steady state nor past the limit");
+      (status == "ok" ? steadyRows : pastRows).push_back(i);
+    }
     const std::size_t want = std::min<std::size_t>(std::size_t(samples), n);
     const std::size_t nSteady =
         std::min(steadyRows.size(), std::max(want / 2, want - std::min(want, pastRows.size())));
@@ -186,12 +195,11 @@ int main(int argc, char** argv) {
                                     : "stayed in its regime for " + std::to_string(tPast) + " s";
       }
       (verdict == "DISAGREES" ? disagree : agree)++;
-      const std::string reason = ok ? "steady" : r.at("reason").get<std::string>().find("lift-off") != std::string::npos
-                                                     ? "past lift-off"
-                                                     : "past the fold";
+      const std::string status = r.at("status").get<std::string>();
+      const std::string reason = ok ? "steady" : status == "past_lift_off" ? "past lift-off" : "past the fold";
       std::printf("  %4zu  %-14s  %14.10g  %14.10g  %9.1e  %s%s%s\n", i, reason.c_str(), expected, got, rel,
                   verdict.c_str(), detail.empty() ? "" : ": ", detail.substr(0, 90).c_str());
-      csv += std::to_string(i) + "," + (ok ? "ok" : "failed") + "," + reason + "," + formatValue(expected) + "," +
+      csv += std::to_string(i) + "," + status + "," + reason + "," + formatValue(expected) + "," +
              formatValue(got) + "," + formatValue(rel) + "," + verdict + "," + formatSweepField(Json(detail)) + "\n";
     }
     std::printf("  %d of %zu agree (settle within %.0e, or leave past the limit); %.1f s wall, %.1f s CPU, %d threads\n",

@@ -103,7 +103,7 @@ void renderSweepPlots(const SweepDescription& d, const SweepResult& r, const std
       }
       if (!std::any_of(series.begin(), series.end(), [&](const std::string& s) { return hasPoint(p, panel, s); })) {
         q.series.clear();
-        q.title += ": no point (every row failed; results.csv says why)";
+        q.title += ": no point (no row ok; results.csv's status and reason say why)";
       }
       fig.panels.push_back(q);
     }
@@ -181,15 +181,19 @@ int sweepCommand(const std::vector<std::string>& args) {
     if (!vm.count("no-plots")) renderSweepPlots(sweep, r, out);
   }
   if (!manager) return 0;
-  std::printf("vdyn sweep: %s: %zu variations, %zu run now (%zu from the journal), %zu failed; %.2f s wall, %.2f s CPU, "
-              "%d %s\n",
-              sweep.name.c_str(), sweep.variations.size(), r.ran, r.resumed, r.failed, r.wall_s, r.cpu_s, r.workers,
+  std::string named;  // e.g. ", 40 beyond_fold": rows that are a named outcome, not a failure
+  for (const auto& [status, count] : r.outcomes) named += ", " + std::to_string(count) + " " + status;
+  std::printf("vdyn sweep: %s: %zu variations, %zu run now (%zu from the journal), %zu failed%s; %.2f s wall, %.2f s "
+              "CPU, %d %s\n",
+              sweep.name.c_str(), sweep.variations.size(), r.ran, r.resumed, r.failed, named.c_str(), r.wall_s, r.cpu_s,
+              r.workers,
               r.runner == "mpi" ? "MPI workers" : "threads");
   std::printf("  %s/results.csv, results.json, sweep_stats.json%s\n", out.c_str(),
               sweep.plots.empty() || vm.count("no-plots") ? "" : ", plots");
   int shown = 0;
   for (const SweepRow& row : r.rows)
-    if (!row.ok && shown++ < 5) std::printf("  variation %zu failed: %s\n", row.index, row.reason.c_str());
+    if (sweepStatus(row) == "failed" && shown++ < 5)
+      std::printf("  variation %zu failed: %s\n", row.index, row.reason.c_str());
   return 0;
 }
 

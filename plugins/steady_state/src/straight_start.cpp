@@ -1,5 +1,7 @@
 #include "vdyn/steady_state/straight_start.h"
 
+#include "vdyn/core/named_outcome.h"
+
 #include <cmath>
 
 namespace vdyn {
@@ -73,7 +75,8 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
       if (f0 > 0 && f < 0.02 * f0 && (tire.empty() || f / f0 < fz / fz0)) tire = n, fz = f, fz0 = f0;
     }
     if (tire.empty()) throw;
-    throw Error("no steady state found on the branch from straight running past a wheel lift-off: " + tire + " = " +
+    throw NamedOutcome("past_lift_off",
+                       "no steady state found on the branch from straight running past a wheel lift-off: " + tire + " = " +
                 formatValue(fz) + " N (" + formatValue(fz0) + " N at straight running) at front steer " +
                 (frontSteer ? formatValue(frontSteer(last.state) * 180 / SimTK::Pi) : std::string("(unknown)")) +
                 " deg (lateral acceleration " + formatValue(lateralOf(scene, solver, last.state)) +
@@ -89,7 +92,7 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
     if (sp.kind != "fold" || !(sp.point.lambda < T)) continue;
     const SteadyStateResult f = solver.makeDrivenResult(sp.point.x, sp.point.lambda);
     const double ay = lateralOf(scene, solver, f.state);
-    throw Error("no steady state on the branch from straight running: fold at front steer " +
+    throw NamedOutcome("beyond_fold", "no steady state on the branch from straight running: fold at front steer " +
                 (frontSteer ? formatValue(frontSteer(f.state) * 180 / SimTK::Pi) : std::string("(unknown)")) +
                 " deg (lateral acceleration " + formatValue(ay) + " m/s^2), at command time " +
                 formatValue(sp.point.lambda) + " s of " + formatValue(T) + " s");

@@ -11,7 +11,9 @@
 //  - runSweep(): the in-process runner. Worker threads take variations one at a
 //    time (dynamic load balancing), each run builds its own Simbody system (the
 //    run function must be safe to call from several threads on different
-//    variations). A run that throws is a failed row carrying the message.
+//    variations). A run that throws is a failed row carrying the message; one
+//    that throws a NamedOutcome (vdyn/core/named_outcome.h) is a row with that
+//    outcome's status (e.g. beyond_fold), counted apart from the failed ones.
 //  - With an output folder: every finished run is appended to runs.jsonl at
 //    once (one line, flushed), so a killed sweep resumes where it stopped
 //    (runs already in the journal are skipped); results.csv and results.json,
@@ -26,6 +28,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <functional>
+#include <map>
 #include <memory>
 #include <string>
 #include <vector>
@@ -153,16 +156,21 @@ struct SweepDescription {
 /// The result of one variation.
 struct SweepRow {
   std::size_t index = 0;
-  bool ok = false;
-  std::string reason;          ///< why it failed ("" when ok)
+  bool ok = false;             ///< the run gave a summary (status "ok")
+  std::string outcome;         ///< not ok: the NamedOutcome's status, "" for a failure
+  std::string reason;          ///< why it failed or has no result ("" when ok)
   std::vector<Json> values;    ///< one per collected path (null when failed)
   Json summary;                ///< the run's whole summary (null when failed)
   double wall_s = 0, cpu_s = 0;  ///< the run's wall and CPU (its thread's) time
   bool resumed = false;        ///< taken from the journal, not run now
 };
 
+/// The row's status: "ok", its named outcome (e.g. "beyond_fold") or "failed".
+std::string sweepStatus(const SweepRow& row);
+
 /// What a run function gets and returns: a variation in, its summary out.
-/// Throwing (any std::exception) makes the row a failure with the message.
+/// Throwing (any std::exception) makes the row a failure with the message; a
+/// NamedOutcome makes it a row of that status.
 /// Called concurrently from several threads for different variations.
 using SweepRunFunction = std::function<Json(const SweepDescription&, const Variation&)>;
 
@@ -187,12 +195,13 @@ void collectValues(const SweepDescription& d, SweepRow& row);
 struct SweepProgress {
   std::size_t total = 0;    ///< variations in the sweep
   std::size_t skipped = 0;  ///< taken from the journal
-  std::size_t done = 0;     ///< finished in this session (ok + failed)
+  std::size_t done = 0;     ///< finished in this session (ok + failed + named outcomes)
   std::size_t failed = 0;   ///< of done
+  std::map<std::string, std::size_t> outcomes;  ///< of done: rows per named outcome status
   double elapsed_s = 0;
   double eta_s = -1;        ///< estimated time left (-1 before the first run)
 };
-/// Prints "<label>: 37/216 runs (2 failed, 10 from the journal), 12 s, about 40 s left"
+/// Prints "<label>: 37/216 runs (2 failed, 5 beyond_fold, 10 from the journal), 12 s, about 40 s left"
 /// on stderr: a rewritten line on a terminal, else a line at most every 5 s.
 std::function<void(const SweepProgress&)> sweepProgressPrinter(const std::string& label);
 
@@ -200,13 +209,14 @@ struct SweepOptions {
   int threads = 1;           ///< worker threads (>= 1)
   std::string out_dir;       ///< "" = in memory only: no journal, no files
   bool resume = true;        ///< skip runs already in the journal
-  bool retry_failed = false; ///< ... except failed ones, which run again
+  bool retry_failed = false; ///< ... except failed ones (not named outcomes), which run again
   std::function<void(const SweepProgress&)> progress;  ///< after each finished run
 };
 
 struct SweepResult {
   std::vector<SweepRow> rows;  ///< every variation, in order
-  std::size_t ran = 0, failed = 0, resumed = 0;
+  std::size_t ran = 0, failed = 0, resumed = 0;  ///< failed: status "failed" only
+  std::map<std::string, std::size_t> outcomes;     ///< rows per named outcome status (every row, resumed too)
   double wall_s = 0;           ///< wall time of this session
   double cpu_s = 0;            ///< process CPU time of this session (all threads)
   int workers = 0;             ///< threads or ranks that ran variations
@@ -257,12 +267,13 @@ std::unique_ptr<AppendFile> openSweepJournal(const std::string& dir, bool append
 /// ascending.
 std::vector<std::size_t> prepareSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
                                          std::unique_ptr<AppendFile>& journal);
-/// Ends a run of either runner: counts the failed rows into `res.failed`, sets
+/// Ends a run of either runner: counts the failed rows into `res.failed` and the
+/// named outcomes into `res.outcomes`, sets
 /// `res.wall_s` and `res.cpu_s` (since `start` and processCpuSeconds() = `cpu0`)
 /// and writes the outputs into o.out_dir (writeSweepOutputs; none when "").
 void finishSweepRun(const SweepDescription& d, const SweepOptions& o, SweepResult& res,
                     std::chrono::steady_clock::time_point start, double cpu0);
-/// results.csv text: variation,status,<keys>,<collect>,reason.
+/// results.csv text: variation,status,<keys>,<collect>,reason (status: sweepStatus).
 std::string formatSweepCsv(const SweepDescription& d, const std::vector<SweepRow>& rows);
 /// results.json text.
 std::string formatSweepJson(const SweepDescription& d, const std::vector<SweepRow>& rows);

@@ -20,10 +20,13 @@ struct StraightStartReport {
 /// directly from `initial`, and the command time is continued from 0 to time_s
 /// by pseudo-arclength continuation (continueSteadyState); the point at time_s
 /// is then solved by Newton from the branch's two neighbouring points
-/// (interpolated). A fold on the way is the Error "no steady state on the
-/// branch from straight running: fold at front steer X deg (lateral
-/// acceleration Y m/s^2)" (frontSteer(state) gives X in rad, or none if
-/// empty; Y is the yaw rate x horizontal speed of the floating base). With
+/// (interpolated). A fold on the way is the NamedOutcome "beyond_fold" (an
+/// Error; vdyn/core/named_outcome.h) "no steady state on the branch from
+/// straight running: fold at front steer X deg (lateral acceleration Y m/s^2)"
+/// (frontSteer(state) gives X in rad, or none if empty; Y is the yaw rate x
+/// horizontal speed of the floating base); a wheel lifting off on the way is
+/// the NamedOutcome "past_lift_off" ("no steady state found on the branch from
+/// straight running past a wheel lift-off: ..."). With
 /// time_s = 0 it is the direct solve from `initial`.
 SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scene& scene, const SimTK::State& initial,
                                            const std::function<double(const SimTK::State&)>& frontSteer,
