@@ -43,7 +43,6 @@
 // this force does nothing and the Simbody rows act. Simbody's constraint
 // multipliers are not available in a dense state; the speed hold's force
 // (speed_hold.force_N) is read from this element (speedHoldForce).
-// Not thread-safe (workspace in the object), as ReducedKnuckleMobilizer.
 #include <memory>
 #include <vector>
 
@@ -109,16 +108,50 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   /// realizeDynamics of its forces once the sums are complete): adds G^T lambda.
   void realizeDynamics(const SimTK::State& s) const override;
 
+ /// G M^-1 G^T of the rows in `s` (Stage::Dynamics of a dense state), by
+  /// the articulated-body blocks (`byProducts` false, what realizeDynamics
+  /// uses when the rows' bodies allow it) or by one multiplyByMInv per row
+  /// (true): two independent ways, for tests.
+  SimTK::Matrix calcRowMatrix(const SimTK::State& s, bool byProducts) const;
+
  private:
-  /// One row: sparse G (u index, coefficient), the right side b of G udot = b
-  /// (with the Baumgarte terms), and the errors.
+  /// One row: sparse G (u index, coefficient, mobilized body, its mobility),
+  /// the right side b of G udot = b (with the Baumgarte terms), and the errors.
   struct RowEval {
     int n = 0;
     int u[3];
     double g[3];
+    int body[3];  ///< MobilizedBodyIndex of u[k]
+    int ux[3];    ///< u[k]'s index among its mobilizer's mobilities
     double b = 0, perr = 0, verr = 0;
   };
-  void evalRows(const SimTK::State& s) const;
+  /// A body of the chassis's branch whose mobilities some row touches: H (in
+  /// Ground, at its origin), the branch's D^-1 = (H^T P H)^-1 (P its
+  /// articulated-body inertia) and L = H_c^T Phi P H D^-1 (the chassis's
+  /// share, H_c the chassis's hinge matrix, Phi the shift to its origin).
+  struct BranchBody {
+    int body = -1, nu = 0;
+    bool known = false;  ///< prescribed u': M^-1 is 0 on its mobilities
+    double Dinv[6][6];
+    double L[6][6];  ///< L[k][j]: chassis mobility k, this body's mobility j
+  };
+  /// Per-state workspace (a cache entry; no buffers shared between states).
+  struct Work {
+    std::vector<RowEval> rows;
+    SimTK::Vector udot0, v;
+    std::vector<SimTK::Vector> Y;
+    SimTK::Vector_<SimTK::SpatialVec> A_GB;
+    std::vector<double> A, r, t;
+    std::vector<BranchBody> branch;
+    std::vector<int> entryBranch;  ///< per row entry (3 per row): index into branch, -1 the chassis, -2 none
+  };
+  void evalRows(const SimTK::State& s, std::vector<RowEval>& rows) const;
+  Work& updWork(const SimTK::State& s) const;
+  /// Fills w.A (lower triangle, m x m) with G M^-1 G^T; false if the rows'
+  /// bodies are not the chassis (a Ground child) and its children (then
+  /// the products are used, or when `byProducts`).
+  bool formBlocks(const SimTK::State& s, Work& w) const;
+  void formProducts(const SimTK::State& s, Work& w) const;
 
   const SimTK::SimbodyMatterSubsystem* matter_;
   const SimTK::GeneralForceSubsystem* forces_;
@@ -128,12 +161,7 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   mutable SimTK::DiscreteVariableIndex activeIndex_;
   mutable SimTK::DiscreteVariableIndex releasedIndex_;  ///< std::vector<int>: 1 = the k-th hold released
   mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
-  // Workspace.
-  mutable std::vector<RowEval> rows_;
-  mutable SimTK::Vector udot0_, v_;
-  mutable std::vector<SimTK::Vector> Y_;
-  mutable SimTK::Vector_<SimTK::SpatialVec> A_GB_;
-  mutable std::vector<double> A_, r_;
+  mutable SimTK::CacheEntryIndex workIndex_;    ///< Work (Stage::Instance: its contents are scratch)
 };
 
 }  // namespace vdyn
