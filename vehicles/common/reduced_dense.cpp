@@ -21,6 +21,7 @@ void ReducedDenseRows::realizeTopology(SimTK::State& s) const {
       forces_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<std::vector<int>>());
   lambdaIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Dynamics, new SimTK::Value<SimTK::Vector>());
   workIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Instance, new SimTK::Value<Work>());
+  structureIndex_ = forces_->allocateLazyCacheEntry(s, SimTK::Stage::Instance, new SimTK::Value<Structure>());
 }
 
 ReducedDenseRows::Work& ReducedDenseRows::updWork(const SimTK::State& s) const {
@@ -211,6 +212,58 @@ void ReducedDenseRows::formProducts(const SimTK::State& s, Work& w) const {
   }
 }
 
+const ReducedDenseRows::Structure& ReducedDenseRows::getStructure(const SimTK::State& s,
+                                                                    const std::vector<RowEval>& rows) const {
+  using SimTK::MobilizedBody;
+  using SimTK::MobilizedBodyIndex;
+  if (forces_->isCacheValueRealized(s, structureIndex_))
+    return SimTK::Value<Structure>::downcast(forces_->getCacheEntry(s, structureIndex_)).get();
+  Structure& st = SimTK::Value<Structure>::updDowncast(forces_->updCacheEntry(s, structureIndex_)).upd();
+  st = Structure();
+  forces_->markCacheValueRealized(s, structureIndex_);
+  // The chassis: every entry's body is it or one of its children.
+  int base = -1;
+  for (const RowEval& r : rows)
+    for (int k = 0; k < r.n; ++k) {
+      const MobilizedBody& b = matter_->getMobilizedBody(MobilizedBodyIndex(r.body[k]));
+      const MobilizedBody& p = b.getParentMobilizedBody();
+      int c;
+      if (p.isGround()) c = r.body[k];
+      else if (p.getParentMobilizedBody().isGround()) c = p.getMobilizedBodyIndex();
+      else return st;
+      if (base >= 0 && c != base) return st;
+      base = c;
+    }
+  if (base < 0) return st;
+  st.chassis = &matter_->getMobilizedBody(MobilizedBodyIndex(base));
+  if (st.chassis->getUDotMotionMethod(s) != SimTK::Motion::Free) return st;
+  st.nc = st.chassis->getNumU(s);
+  const int m = int(rows.size());
+  st.entryChild.assign(std::size_t(3) * m, -1);
+  for (int i = 0; i < m; ++i) {
+    const RowEval& r = rows[i];
+    for (int k = 0; k < r.n; ++k) {
+      if (r.body[k] == base) continue;
+      const MobilizedBody& B = matter_->getMobilizedBody(MobilizedBodyIndex(r.body[k]));
+      int e = 0;
+      while (e < int(st.children.size()) && st.children[e].body != &B) ++e;
+      st.entryChild[3 * i + k] = e;
+      if (e == int(st.children.size()))
+        st.children.push_back({&B, B.getNumU(s), B.getUDotMotionMethod(s) != SimTK::Motion::Free});
+    }
+  }
+  for (int i = 0; i < m; ++i)
+    for (int k = 0; k < rows[i].n; ++k) {
+      const int e = st.entryChild[3 * i + k];
+      if (e < 0 || st.children[e].known) continue;
+      for (int j = 0; j <= i; ++j)
+        for (int l = 0; l < rows[j].n; ++l)
+          if (st.entryChild[3 * j + l] == e) st.pairs.push_back({i, k, j, l, e});
+    }
+  st.blocks = true;
+  return st;
+}
+
 // G M^-1 G^T from the articulated-body inertias, when every row touches
 // only the chassis c (a child of Ground) and its children b. With M^-1 in
 // the blocks of the articulated-body algorithm (u_c' = S^-1 (tau_c - L tau_b),
@@ -226,29 +279,14 @@ void ReducedDenseRows::formProducts(const SimTK::State& s, Work& w) const {
 // (multiplyByMInv's convention): its entries are left out.
 bool ReducedDenseRows::formBlocks(const SimTK::State& s, Work& w) const {
   using SimTK::MobilizedBody;
-  using SimTK::MobilizedBodyIndex;
-  const int m = int(w.rows.size());
-  // The chassis: every entry's body is it or one of its children.
-  int base = -1;
-  for (const RowEval& r : w.rows)
-    for (int k = 0; k < r.n; ++k) {
-      const MobilizedBody& b = matter_->getMobilizedBody(MobilizedBodyIndex(r.body[k]));
-      const MobilizedBody& p = b.getParentMobilizedBody();
-      int c;
-      if (p.isGround()) c = r.body[k];
-      else if (p.getParentMobilizedBody().isGround()) c = p.getMobilizedBodyIndex();
-      else return false;
-      if (base >= 0 && c != base) return false;
-      base = c;
-    }
-  if (base < 0) return false;
-  const MobilizedBody& C = matter_->getMobilizedBody(MobilizedBodyIndex(base));
-  if (C.getUDotMotionMethod(s) != SimTK::Motion::Free) return false;
-  const int nc = C.getNumU(s);
+  const Structure& st = getStructure(s, w.rows);
+  if (!st.blocks) return false;
+  const int m = int(w.rows.size()), nc = st.nc;
+  const MobilizedBody& C = *st.chassis;
   SimTK::SpatialVec Hc[6];
   double S[36];
   {
-    const SimTK::ArticulatedInertia& P = matter_->getArticulatedBodyInertia(s, MobilizedBodyIndex(base));
+    const SimTK::ArticulatedInertia& P = matter_->getArticulatedBodyInertia(s, C.getMobilizedBodyIndex());
     for (int j = 0; j < nc; ++j) Hc[j] = C.getHCol(s, SimTK::MobilizerUIndex(j));
     for (int j = 0; j < nc; ++j) {
       const SimTK::SpatialVec X = P * Hc[j];
@@ -257,49 +295,35 @@ bool ReducedDenseRows::formBlocks(const SimTK::State& s, Work& w) const {
     if (!cholesky(S, nc, 6)) return false;
   }
   const Vec3 pc = C.getBodyOriginLocation(s);
-  // The children the rows touch.
-  w.branch.clear();
-  w.entryBranch.assign(std::size_t(3) * m, -1);
-  for (int i = 0; i < m; ++i) {
-    const RowEval& r = w.rows[i];
-    for (int k = 0; k < r.n; ++k) {
-      if (r.body[k] == base) continue;
-      int e = 0;
-      while (e < int(w.branch.size()) && w.branch[e].body != r.body[k]) ++e;
-      w.entryBranch[3 * i + k] = e;
-      if (e < int(w.branch.size())) continue;
-      w.branch.emplace_back();
-      BranchBody& bb = w.branch.back();
-      const MobilizedBodyIndex bx(r.body[k]);
-      const MobilizedBody& B = matter_->getMobilizedBody(bx);
-      bb.body = r.body[k];
-      bb.nu = B.getNumU(s);
-      bb.known = B.getUDotMotionMethod(s) != SimTK::Motion::Free;
-      if (bb.known) continue;
-      const SimTK::ArticulatedInertia& P = matter_->getArticulatedBodyInertia(s, bx);
-      SimTK::SpatialVec H[6], X[6];
-      double D[36];
-      for (int j = 0; j < bb.nu; ++j) {
-        H[j] = B.getHCol(s, SimTK::MobilizerUIndex(j));
-        X[j] = P * H[j];
-      }
-      for (int j = 0; j < bb.nu; ++j)
-        for (int l = j; l < bb.nu; ++l) D[l * 6 + j] = dot(H[l], X[j]);
-      if (!cholesky(D, bb.nu, 6)) return false;
-      for (int j = 0; j < bb.nu; ++j) {  // column j of D^-1
-        double x[6] = {0, 0, 0, 0, 0, 0};
-        x[j] = 1;
-        forwardSolve(D, bb.nu, 6, x);
-        backSolve(D, bb.nu, 6, x);
-        for (int l = 0; l < bb.nu; ++l) bb.Dinv[l][j] = x[l];
-      }
-      const Vec3 rc = B.getBodyOriginLocation(s) - pc;
-      for (int j = 0; j < bb.nu; ++j) {
-        SimTK::SpatialVec Y(Vec3(0), Vec3(0));
-        for (int l = 0; l < bb.nu; ++l) Y += X[l] * bb.Dinv[l][j];  // P H D^-1, at B's origin
-        const SimTK::SpatialVec F(Y[0] + SimTK::cross(rc, Y[1]), Y[1]);  // at the chassis's origin
-        for (int c = 0; c < nc; ++c) bb.L[c][j] = dot(Hc[c], F);
-      }
+  w.blocks.resize(st.children.size());
+  for (std::size_t e = 0; e < st.children.size(); ++e) {
+    const Structure::Child& ch = st.children[e];
+    if (ch.known) continue;
+    ChildBlocks& bb = w.blocks[e];
+    const MobilizedBody& B = *ch.body;
+    const SimTK::ArticulatedInertia& P = matter_->getArticulatedBodyInertia(s, B.getMobilizedBodyIndex());
+    SimTK::SpatialVec H[6], X[6];
+    double D[36];
+    for (int j = 0; j < ch.nu; ++j) {
+      H[j] = B.getHCol(s, SimTK::MobilizerUIndex(j));
+      X[j] = P * H[j];
+    }
+    for (int j = 0; j < ch.nu; ++j)
+      for (int l = j; l < ch.nu; ++l) D[l * 6 + j] = dot(H[l], X[j]);
+    if (!cholesky(D, ch.nu, 6)) return false;
+    for (int j = 0; j < ch.nu; ++j) {  // column j of D^-1
+      double x[6] = {0, 0, 0, 0, 0, 0};
+      x[j] = 1;
+      forwardSolve(D, ch.nu, 6, x);
+      backSolve(D, ch.nu, 6, x);
+      for (int l = 0; l < ch.nu; ++l) bb.Dinv[l][j] = x[l];
+    }
+    const Vec3 rc = B.getBodyOriginLocation(s) - pc;
+    for (int j = 0; j < ch.nu; ++j) {
+      SimTK::SpatialVec Y(Vec3(0), Vec3(0));
+      for (int l = 0; l < ch.nu; ++l) Y += X[l] * bb.Dinv[l][j];  // P H D^-1, at B's origin
+      const SimTK::SpatialVec F(Y[0] + SimTK::cross(rc, Y[1]), Y[1]);  // at the chassis's origin
+      for (int c = 0; c < nc; ++c) bb.L[c][j] = dot(Hc[c], F);
     }
   }
   // t_i = Ls^-1 w_i (S = Ls Ls^T), w_i = g_ic - L g_ib.
@@ -308,30 +332,27 @@ bool ReducedDenseRows::formBlocks(const SimTK::State& s, Work& w) const {
     const RowEval& r = w.rows[i];
     double* t = &w.t[std::size_t(i) * 6];
     for (int k = 0; k < r.n; ++k) {
-      const int e = w.entryBranch[3 * i + k];
+      const int e = st.entryChild[3 * i + k];
       if (e < 0) t[r.ux[k]] += r.g[k];
-      else if (!w.branch[e].known)
-        for (int c = 0; c < nc; ++c) t[c] -= w.branch[e].L[c][r.ux[k]] * r.g[k];
+      else if (!st.children[e].known)
+        for (int c = 0; c < nc; ++c) t[c] -= w.blocks[e].L[c][r.ux[k]] * r.g[k];
     }
     forwardSolve(S, nc, 6, t);
   }
+  // A = t t^T + the children's g^T D^-1 g (lower triangle).
   w.A.assign(std::size_t(m) * m, 0.0);
   for (int i = 0; i < m; ++i) {
-    const RowEval& ri = w.rows[i];
     const double* ti = &w.t[std::size_t(i) * 6];
     for (int j = 0; j <= i; ++j) {
-      const RowEval& rj = w.rows[j];
       const double* tj = &w.t[std::size_t(j) * 6];
       double a = 0;
       for (int c = 0; c < nc; ++c) a += ti[c] * tj[c];
-      for (int k = 0; k < ri.n; ++k) {
-        const int e = w.entryBranch[3 * i + k];
-        if (e < 0 || w.branch[e].known) continue;
-        for (int l = 0; l < rj.n; ++l)
-          if (w.entryBranch[3 * j + l] == e) a += ri.g[k] * rj.g[l] * w.branch[e].Dinv[ri.ux[k]][rj.ux[l]];
-      }
       w.A[i * m + j] = a;
     }
+  }
+  for (const Structure::Pair& p : st.pairs) {
+    const RowEval &ri = w.rows[p.i], &rj = w.rows[p.j];
+    w.A[p.i * m + p.j] += ri.g[p.k] * rj.g[p.l] * w.blocks[p.child].Dinv[ri.ux[p.k]][rj.ux[p.l]];
   }
   return true;
 }

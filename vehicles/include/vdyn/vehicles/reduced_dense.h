@@ -125,15 +125,35 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
     int ux[3];    ///< u[k]'s index among its mobilizer's mobilities
     double b = 0, perr = 0, verr = 0;
   };
-  /// A body of the chassis's branch whose mobilities some row touches: H (in
-  /// Ground, at its origin), the branch's D^-1 = (H^T P H)^-1 (P its
-  /// articulated-body inertia) and L = H_c^T Phi P H D^-1 (the chassis's
-  /// share, H_c the chassis's hinge matrix, Phi the shift to its origin).
-  struct BranchBody {
-    int body = -1, nu = 0;
-    bool known = false;  ///< prescribed u': M^-1 is 0 on its mobilities
+  /// Which bodies the rows touch (Stage::Instance: the speed holds released
+  /// change the rows), computed on the first evaluation after a change.
+  struct Structure {
+    /// Every row touches only the chassis (a child of Ground, u' free) and
+    /// its children: formBlocks applies.
+    bool blocks = false;
+    const SimTK::MobilizedBody* chassis = nullptr;
+    int nc = 0;  ///< the chassis's mobilities
+    struct Child {
+      const SimTK::MobilizedBody* body;
+      int nu;
+      bool known;  ///< prescribed u': M^-1 is 0 on its mobilities
+    };
+    std::vector<Child> children;
+    std::vector<int> entryChild;  ///< per row entry (3 per row): index into children, -1 the chassis
+    /// Entries (row i, entry k) and (row j, entry l), i >= j, on the same
+    /// free child: the terms of g_ib^T D^-1 g_jb.
+    struct Pair {
+      int i, k, j, l, child;
+    };
+    std::vector<Pair> pairs;
+  };
+  /// A child's D^-1 = (H^T P H)^-1 (H its hinge matrix in Ground at its
+  /// origin, P its articulated-body inertia) and L = H_c^T Phi P H D^-1 (the
+  /// chassis's share, H_c the chassis's hinge matrix, Phi the shift to its
+  /// origin).
+  struct ChildBlocks {
     double Dinv[6][6];
-    double L[6][6];  ///< L[k][j]: chassis mobility k, this body's mobility j
+    double L[6][6];  ///< L[c][j]: chassis mobility c, the child's mobility j
   };
   /// Per-state workspace (a cache entry; no buffers shared between states).
   struct Work {
@@ -142,11 +162,11 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
     std::vector<SimTK::Vector> Y;
     SimTK::Vector_<SimTK::SpatialVec> A_GB;
     std::vector<double> A, r, t;
-    std::vector<BranchBody> branch;
-    std::vector<int> entryBranch;  ///< per row entry (3 per row): index into branch, -1 the chassis, -2 none
+    std::vector<ChildBlocks> blocks;
   };
   void evalRows(const SimTK::State& s, std::vector<RowEval>& rows) const;
   Work& updWork(const SimTK::State& s) const;
+  const Structure& getStructure(const SimTK::State& s, const std::vector<RowEval>& rows) const;
   /// Fills w.A (lower triangle, m x m) with G M^-1 G^T; false if the rows'
   /// bodies are not the chassis (a Ground child) and its children (then
   /// the products are used, or when `byProducts`).
@@ -162,6 +182,7 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   mutable SimTK::DiscreteVariableIndex releasedIndex_;  ///< std::vector<int>: 1 = the k-th hold released
   mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
   mutable SimTK::CacheEntryIndex workIndex_;    ///< Work (Stage::Instance: its contents are scratch)
+  mutable SimTK::CacheEntryIndex structureIndex_;  ///< Structure (Stage::Instance, lazy)
 };
 
 }  // namespace vdyn
