@@ -60,13 +60,14 @@ void ReducedDenseRows::setActive(SimTK::State& s, bool active) const {
 
 void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& rows) const {
   const double w = kBaumgarteRate_per_s;
-  const SimTK::Vector& u = s.getU();
+  const double* u = s.getU().getContiguousScalarData();  // (the state's q and u are contiguous)
+  const double* q = s.getQ().getContiguousScalarData();
   rows.resize(numRows());
   std::size_t i = 0;
   int k = 0;
   for (const Arm& a : arms_) {
     const int us = a.knuckle.getFirstUIndex(s);
-    const double sq = a.knuckle.getOneQ(s, 0), su = u[us];
+    const double sq = q[a.knuckle.getFirstQIndex(s)], su = u[us];
     const int bk = a.knuckle.getMobilizedBodyIndex(), bl = a.lower.getMobilizedBodyIndex(),
               bu = a.upper.getMobilizedBodyIndex();
     // Lower arm: q_L = s.
@@ -76,7 +77,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& row
       r.n = 2;
       r.u[0] = ul, r.g[0] = 1, r.body[0] = bl, r.ux[0] = 0;
       r.u[1] = us, r.g[1] = -1, r.body[1] = bk, r.ux[1] = 0;
-      r.perr = a.lower.getOneQ(s, 0) - sq;
+      r.perr = q[a.lower.getFirstQIndex(s)] - sq;
       r.verr = u[ul] - su;
       r.b = -2 * w * r.verr - w * w * r.perr;
     }
@@ -88,7 +89,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& row
       r.n = 2;
       r.u[0] = uu, r.g[0] = 1, r.body[0] = bu, r.ux[0] = 0;
       r.u[1] = us, r.g[1] = -t4[1], r.body[1] = bk, r.ux[1] = 0;
-      r.perr = a.upper.getOneQ(s, 0) - t4[0];
+      r.perr = q[a.upper.getFirstQIndex(s)] - t4[0];
       r.verr = u[uu] - t4[1] * su;
       r.b = t4[2] * su * su - 2 * w * r.verr - w * w * r.perr;
     }
@@ -102,7 +103,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& row
       const SteerCommandValue c = st.command->calcAt(t);
       r.n = 1;
       r.u[0] = ud, r.g[0] = 1, r.body[0] = bk, r.ux[0] = 1;
-      r.perr = st.knuckle.getOneQ(s, 1) - c.angle_rad;
+      r.perr = q[st.knuckle.getFirstQIndex(s) + 1] - c.angle_rad;
       r.verr = u[ud] - c.rate_rad_s;
       r.b = c.accel_rad_s2 - 2 * w * r.verr - w * w * r.perr;
     } else {
@@ -111,7 +112,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& row
       r.n = 2;
       r.u[0] = ud, r.g[0] = 1, r.body[0] = bk, r.ux[0] = 1;
       r.u[1] = uD, r.g[1] = -1, r.body[1] = st.steer.getMobilizedBodyIndex(), r.ux[1] = 0;
-      r.perr = st.knuckle.getOneQ(s, 1) - st.steer.getOneQ(s, 0);
+      r.perr = q[st.knuckle.getFirstQIndex(s) + 1] - q[st.steer.getFirstQIndex(s)];
       r.verr = u[ud] - u[uD];
       r.b = -2 * w * r.verr - w * w * r.perr;
     }
