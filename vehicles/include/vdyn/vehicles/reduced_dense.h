@@ -22,13 +22,19 @@
 // loop's), so the equations of motion are the same. Per evaluation, with the
 // applied forces f (every force element's, summed by Simbody) and M, G, b:
 //   udot0 = M^-1 (f - c)                (calcAccelerationIgnoringConstraints)
-//   Y     = M^-1 G^T                    (one multiplyByMInv per row)
-//   (G Y) lambda = b - G udot0          (dense Cholesky, m <= 13)
+//   A     = G M^-1 G^T                  (from the articulated-body inertias:
+//                                        formBlocks in reduced_dense.cpp)
+//   A lambda = b - G udot0              (dense Cholesky, m <= 13)
 // and G^T lambda is added to the mobility forces, so Simbody's own tree
-// solve returns udot = udot0 + Y lambda, which meets G udot = b.
+// solve returns udot = udot0 + M^-1 G^T lambda, which meets G udot = b.
+// A needs no tree pass of its own: every row touches only the chassis (a
+// child of Ground) and its children, where M^-1 is given by the chassis's
+// articulated inertia and each child's (H^T P H) and coupling; rows on other
+// bodies would take one multiplyByMInv per row (calcRowMatrix compares both).
 // A prescribed mobility (the steer body's) is not free: udot0 carries its
 // prescribed u' (calcAccelerationIgnoringConstraints obeys Motions) and
-// multiplyByMInv returns 0 there, so its column of G enters G udot0 only and
+// M^-1 is 0 there (multiplyByMInv's convention; formBlocks leaves it out),
+// so its column of G enters G udot0 only and
 // its share of G^T lambda is carried by the Motion's reaction, as the
 // Simbody row's is.
 //
