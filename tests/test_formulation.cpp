@@ -121,6 +121,32 @@ TEST(Formulation, Ch8StateDrivenSteeringDenseAgreesWithConstrained) {
   }
 }
 
+// The same scene's dense rows in its initial state: G M^-1 G^T from the
+// articulated-body inertias (the steer bodies prescribed: their mobilities
+// left out) equals the one-multiplyByMInv-per-row form to 1e-12.
+TEST(Formulation, Ch8StateDrivenRowMatrixOfTheArticulatedBlocksEqualsTheProducts) {
+  const SceneDescription d =
+      SceneDescription::fromFile("scenes/ch8_maneuvers.json", standardRegistry(), {{"vehicle.overrides.formulation", "auto"}});
+  BuiltScene b = d.build();
+  const WheeledVehicle& car = b.vehicleAs<WheeledVehicle>();
+  ASSERT_EQ(car.getFormulation().name, "dense");
+  SimTK::State s = b.makeInitialState();
+  ASSERT_TRUE(car.denseRows()->isActive(s));
+  car.getScene().getSystem().realize(s, SimTK::Stage::Dynamics);
+  const SimTK::Matrix blocks = car.denseRows()->calcRowMatrix(s, false);
+  const SimTK::Matrix products = car.denseRows()->calcRowMatrix(s, true);
+  ASSERT_EQ(blocks.nrow(), products.nrow());
+  ASSERT_GE(blocks.nrow(), 9);  // arm rows and the state-driven steering rows
+  double scale = 0, diff = 0;
+  for (int i = 0; i < products.nrow(); ++i)
+    for (int j = 0; j < products.ncol(); ++j) {
+      scale = std::max(scale, std::abs(products(i, j)));
+      diff = std::max(diff, std::abs(blocks(i, j) - products(i, j)));
+    }
+  EXPECT_GT(scale, 0.0);
+  EXPECT_LT(diff / scale, 1e-12) << blocks << "\n" << products;
+}
+
 namespace {
 
 /// |a - b| <= rel |b| for summary key `k` of both runs (a JSON pointer).

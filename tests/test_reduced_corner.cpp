@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <memory>
+#include <random>
 
 #include "test_util.h"
 #include "vdyn/core/simulation.h"
@@ -299,6 +300,66 @@ TEST(ReducedDense, SameAccelerationsAsSimbodysRowsInTheSameState) {
   EXPECT_LT((d.getUDot() - s.getUDot()).normInf() / scale, 1e-8) << d.getUDot() << "\n" << s.getUDot();
   const auto& hold = dynamic_cast<const SpeedHoldPlugin&>(*red->getScene().getPlugins().back());
   EXPECT_NEAR(hold.calcForce(d), hold.calcForce(s), 1e-8 * std::abs(hold.calcForce(s)) + 1e-9);
+}
+
+/// A random state of the reduced ch3 car (steering rates and accelerations
+/// non-zero, arms, spins, chassis motion perturbed) projected onto Simbody's
+/// rows (1e-13): on the manifold, where the dense rows' Baumgarte terms vanish.
+SimTK::State randomStateOnTheRows(const WheeledVehicle& red, unsigned seed) {
+  const SimTK::MultibodySystem& sys = red.getScene().getSystem();
+  SimTK::State s = red.makeInitialState(10.0);
+  s.setTime(0.9);  // mid steering step
+  std::mt19937 gen(seed);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  for (int i = 0; i < s.getNQ(); ++i) s.updQ()[i] += 0.01 * unit(gen);
+  for (int i = 0; i < s.getNU(); ++i) s.updU()[i] += 0.3 * unit(gen);
+  sys.realize(s, SimTK::Stage::Position);
+  sys.project(s, 1e-10);
+  sys.project(s, 1e-13);  // from 1e-1 in one go Simbody stops at 7e-14
+  return s;
+}
+
+TEST(ReducedDense, RowMatrixOfTheArticulatedBlocksEqualsOneMInvProductPerRow) {
+  // G M^-1 G^T two ways: from the articulated-body inertias (what the
+  // evaluation uses) and from one multiplyByMInv per row (independent).
+  const auto red = ch3Car("reduced", "appendix_a_relaxation.json", false);
+  const SimTK::MultibodySystem& sys = red->getScene().getSystem();
+  for (unsigned seed : {1u, 2u, 3u}) {
+    SimTK::State d = randomStateOnTheRows(*red, seed);
+    red->useDenseRows(d);
+    sys.realize(d, SimTK::Stage::Dynamics);
+    const SimTK::Matrix blocks = red->denseRows()->calcRowMatrix(d, false);
+    const SimTK::Matrix products = red->denseRows()->calcRowMatrix(d, true);
+    ASSERT_EQ(blocks.nrow(), red->denseRows()->numRows());
+    double scale = 0, diff = 0;
+    for (int i = 0; i < products.nrow(); ++i)
+      for (int j = 0; j < products.ncol(); ++j) {
+        scale = std::max(scale, std::abs(products(i, j)));
+        diff = std::max(diff, std::abs(blocks(i, j) - products(i, j)));
+      }
+    EXPECT_GT(scale, 0.0);
+    EXPECT_LT(diff / scale, 1e-12) << blocks << "\n" << products;
+  }
+}
+
+TEST(ReducedDense, SameAccelerationsAsSimbodysRowsInRandomStatesOnTheManifold) {
+  const auto red = ch3Car("reduced", "appendix_a_relaxation.json", false);
+  const SimTK::MultibodySystem& sys = red->getScene().getSystem();
+  for (unsigned seed : {4u, 5u, 6u}) {
+    SimTK::State s = randomStateOnTheRows(*red, seed);
+    SimTK::State d = s;
+    red->useDenseRows(d);
+    sys.realize(s, SimTK::Stage::Acceleration);
+    sys.realize(d, SimTK::Stage::Acceleration);
+    ASSERT_GT(s.getNUDotErr(), 0);  // Simbody's constraint solve ...
+    ASSERT_EQ(d.getNUDotErr(), 0);  // ... against the dense one
+    const auto [perr, verr] = red->denseRows()->calcRowErrors(d);
+    EXPECT_LT(perr, 1e-12);
+    EXPECT_LT(verr, 1e-11);
+    const double scale = s.getUDot().normInf();
+    EXPECT_GT(scale, 1.0);
+    EXPECT_LT((d.getUDot() - s.getUDot()).normInf() / scale, 1e-10) << d.getUDot() << "\n" << s.getUDot();
+  }
 }
 
 TEST(ReducedDense, SameCh3TransientAsSimbodysRows) {

@@ -20,6 +20,12 @@ void ReducedDenseRows::realizeTopology(SimTK::State& s) const {
   releasedIndex_ =
       forces_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<std::vector<int>>());
   lambdaIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Dynamics, new SimTK::Value<SimTK::Vector>());
+  workIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Instance, new SimTK::Value<Work>());
+  structureIndex_ = forces_->allocateLazyCacheEntry(s, SimTK::Stage::Instance, new SimTK::Value<Structure>());
+}
+
+ReducedDenseRows::Work& ReducedDenseRows::updWork(const SimTK::State& s) const {
+  return SimTK::Value<Work>::updDowncast(forces_->updCacheEntry(s, workIndex_)).upd();
 }
 
 double ReducedDenseRows::speedHoldForce(const SimTK::State& s, int k) const {
@@ -52,35 +58,38 @@ void ReducedDenseRows::setActive(SimTK::State& s, bool active) const {
   SimTK::Value<bool>::updDowncast(forces_->updDiscreteVariable(s, activeIndex_)).upd() = active;
 }
 
-void ReducedDenseRows::evalRows(const SimTK::State& s) const {
+void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& rows) const {
   const double w = kBaumgarteRate_per_s;
-  const SimTK::Vector& u = s.getU();
-  rows_.resize(numRows());
+  const double* u = s.getU().getContiguousScalarData();  // (the state's q and u are contiguous)
+  const double* q = s.getQ().getContiguousScalarData();
+  rows.resize(numRows());
   std::size_t i = 0;
   int k = 0;
   for (const Arm& a : arms_) {
     const int us = a.knuckle.getFirstUIndex(s);
-    const double sq = a.knuckle.getOneQ(s, 0), su = u[us];
+    const double sq = q[a.knuckle.getFirstQIndex(s)], su = u[us];
+    const int bk = a.knuckle.getMobilizedBodyIndex(), bl = a.lower.getMobilizedBodyIndex(),
+              bu = a.upper.getMobilizedBodyIndex();
     // Lower arm: q_L = s.
     {
-      RowEval& r = rows_[i++];
+      RowEval& r = rows[i++];
       const int ul = a.lower.getFirstUIndex(s);
       r.n = 2;
-      r.u[0] = ul, r.g[0] = 1;
-      r.u[1] = us, r.g[1] = -1;
-      r.perr = a.lower.getOneQ(s, 0) - sq;
+      r.u[0] = ul, r.g[0] = 1, r.body[0] = bl, r.ux[0] = 0;
+      r.u[1] = us, r.g[1] = -1, r.body[1] = bk, r.ux[1] = 0;
+      r.perr = q[a.lower.getFirstQIndex(s)] - sq;
       r.verr = u[ul] - su;
       r.b = -2 * w * r.verr - w * w * r.perr;
     }
     // Upper arm: q_U = theta4(s); d2/dt2: u_U' - theta4' s'' - theta4'' s'^2 = 0.
     {
-      RowEval& r = rows_[i++];
+      RowEval& r = rows[i++];
       const int uu = a.upper.getFirstUIndex(s);
       const Vec3 t4 = a.loop->calcUpperArmAngle(sq);
       r.n = 2;
-      r.u[0] = uu, r.g[0] = 1;
-      r.u[1] = us, r.g[1] = -t4[1];
-      r.perr = a.upper.getOneQ(s, 0) - t4[0];
+      r.u[0] = uu, r.g[0] = 1, r.body[0] = bu, r.ux[0] = 0;
+      r.u[1] = us, r.g[1] = -t4[1], r.body[1] = bk, r.ux[1] = 0;
+      r.perr = q[a.upper.getFirstQIndex(s)] - t4[0];
       r.verr = u[uu] - t4[1] * su;
       r.b = t4[2] * su * su - 2 * w * r.verr - w * w * r.perr;
     }
@@ -88,22 +97,22 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
   const double t = s.getTime();
   for (const Steer& st : steers_) {
     // delta of the knuckle's mobilizer is the angle of (A.1): delta = command.
-    RowEval& r = rows_[i++];
-    const int ud = st.knuckle.getFirstUIndex(s) + 1;
+    RowEval& r = rows[i++];
+    const int ud = st.knuckle.getFirstUIndex(s) + 1, bk = st.knuckle.getMobilizedBodyIndex();
     if (st.command) {
       const SteerCommandValue c = st.command->calcAt(t);
       r.n = 1;
-      r.u[0] = ud, r.g[0] = 1;
-      r.perr = st.knuckle.getOneQ(s, 1) - c.angle_rad;
+      r.u[0] = ud, r.g[0] = 1, r.body[0] = bk, r.ux[0] = 1;
+      r.perr = q[st.knuckle.getFirstQIndex(s) + 1] - c.angle_rad;
       r.verr = u[ud] - c.rate_rad_s;
       r.b = c.accel_rad_s2 - 2 * w * r.verr - w * w * r.perr;
     } else {
       // State-driven: delta = q_D, q_D'' prescribed (enters through udot0).
       const int uD = st.steer.getFirstUIndex(s);
       r.n = 2;
-      r.u[0] = ud, r.g[0] = 1;
-      r.u[1] = uD, r.g[1] = -1;
-      r.perr = st.knuckle.getOneQ(s, 1) - st.steer.getOneQ(s, 0);
+      r.u[0] = ud, r.g[0] = 1, r.body[0] = bk, r.ux[0] = 1;
+      r.u[1] = uD, r.g[1] = -1, r.body[1] = st.steer.getMobilizedBodyIndex(), r.ux[1] = 0;
+      r.perr = q[st.knuckle.getFirstQIndex(s) + 1] - q[st.steer.getFirstQIndex(s)];
       r.verr = u[ud] - u[uD];
       r.b = -2 * w * r.verr - w * w * r.perr;
     }
@@ -112,7 +121,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
     if (!isSpeedHoldEnabled(s, k++)) continue;  // released: the vehicle coasts
     // SpeedHoldImpl's row on the Free mobilizer's u = [w_G, v_G] (chassis
     // origin velocity in Ground): G = (v_xi e_xi + v_eta e_eta) / U0 on v.
-    RowEval& r = rows_[i++];
+    RowEval& r = rows[i++];
     const int u0 = sp.chassis.getFirstUIndex(s);
     const SimTK::Rotation& R = sp.chassis.getBodyRotation(s);
     const Vec3 wG(u[u0], u[u0 + 1], u[u0 + 2]), vG(u[u0 + 3], u[u0 + 4], u[u0 + 5]);
@@ -121,24 +130,245 @@ void ReducedDenseRows::evalRows(const SimTK::State& s) const {
     const double vx = SimTK::dot(ex, vG), vy = SimTK::dot(ey, vG);
     const Vec3 g = (vx * ex + vy * ey) / U0;
     r.n = 3;
-    for (int k = 0; k < 3; ++k) r.u[k] = u0 + 3 + k, r.g[k] = g[k];
+    for (int k = 0; k < 3; ++k)
+      r.u[k] = u0 + 3 + k, r.g[k] = g[k], r.body[k] = sp.chassis.getMobilizedBodyIndex(), r.ux[k] = 3 + k;
     r.perr = 0;
     r.verr = (vx * vx + vy * vy - U0 * U0) / (2 * U0);
     const double bias =
         (vx * SimTK::dot(SimTK::cross(wG, ex), vG) + vy * SimTK::dot(SimTK::cross(wG, ey), vG)) / U0;
     r.b = -bias - w * r.verr;
   }
-  rows_.resize(i);
+  rows.resize(i);
 }
 
 std::pair<double, double> ReducedDenseRows::calcRowErrors(const SimTK::State& s) const {
-  evalRows(s);
+  std::vector<RowEval> rows;
+  evalRows(s, rows);
   double p = 0, v = 0;
-  for (const RowEval& r : rows_) {
+  for (const RowEval& r : rows) {
     p = std::max(p, std::abs(r.perr));
     v = std::max(v, std::abs(r.verr));
   }
   return {p, v};
+}
+
+namespace {
+// In-place Cholesky of the lower triangle of the n x n row-major a (stride
+// ld); false if not positive definite.
+bool cholesky(double* a, int n, int ld) {
+  for (int j = 0; j < n; ++j) {
+    double d = a[j * ld + j];
+    for (int k = 0; k < j; ++k) d -= a[j * ld + k] * a[j * ld + k];
+    if (!(d > 0)) return false;
+    d = std::sqrt(d);
+    a[j * ld + j] = d;
+    for (int i = j + 1; i < n; ++i) {
+      double x = a[i * ld + j];
+      for (int k = 0; k < j; ++k) x -= a[i * ld + k] * a[j * ld + k];
+      a[i * ld + j] = x / d;
+    }
+  }
+  return true;
+}
+// x := L^-1 x (forward substitution with the factor of cholesky()).
+void forwardSolve(const double* l, int n, int ld, double* x) {
+  for (int i = 0; i < n; ++i) {
+    double a = x[i];
+    for (int k = 0; k < i; ++k) a -= l[i * ld + k] * x[k];
+    x[i] = a / l[i * ld + i];
+  }
+}
+// x := L^-T x.
+void backSolve(const double* l, int n, int ld, double* x) {
+  for (int i = n - 1; i >= 0; --i) {
+    double a = x[i];
+    for (int k = i + 1; k < n; ++k) a -= l[k * ld + i] * x[k];
+    x[i] = a / l[i * ld + i];
+  }
+}
+double dot(const SimTK::SpatialVec& a, const SimTK::SpatialVec& b) { return SimTK::dot(a[0], b[0]) + SimTK::dot(a[1], b[1]); }
+}  // namespace
+
+void ReducedDenseRows::formProducts(const SimTK::State& s, Work& w) const {
+  const int m = int(w.rows.size()), nu = s.getNU();
+  w.Y.resize(m);
+  w.v.resize(nu);
+  w.v = 0;
+  for (int i = 0; i < m; ++i) {
+    const RowEval& r = w.rows[i];
+    for (int k = 0; k < r.n; ++k) w.v[r.u[k]] = r.g[k];
+    matter_->multiplyByMInv(s, w.v, w.Y[i]);
+    for (int k = 0; k < r.n; ++k) w.v[r.u[k]] = 0;
+  }
+  // A = G Y (symmetric positive definite), lower triangle.
+  w.A.assign(std::size_t(m) * m, 0.0);
+  for (int i = 0; i < m; ++i) {
+    const RowEval& ri = w.rows[i];
+    for (int j = 0; j <= i; ++j) {
+      const double* y = w.Y[j].getContiguousScalarData();
+      double a = 0;
+      for (int k = 0; k < ri.n; ++k) a += ri.g[k] * y[ri.u[k]];
+      w.A[i * m + j] = a;
+    }
+  }
+}
+
+const ReducedDenseRows::Structure& ReducedDenseRows::getStructure(const SimTK::State& s,
+                                                                    const std::vector<RowEval>& rows) const {
+  using SimTK::MobilizedBody;
+  using SimTK::MobilizedBodyIndex;
+  if (forces_->isCacheValueRealized(s, structureIndex_))
+    return SimTK::Value<Structure>::downcast(forces_->getCacheEntry(s, structureIndex_)).get();
+  Structure& st = SimTK::Value<Structure>::updDowncast(forces_->updCacheEntry(s, structureIndex_)).upd();
+  st = Structure();
+  forces_->markCacheValueRealized(s, structureIndex_);
+  // The chassis: every entry's body is it or one of its children.
+  int base = -1;
+  for (const RowEval& r : rows)
+    for (int k = 0; k < r.n; ++k) {
+      const MobilizedBody& b = matter_->getMobilizedBody(MobilizedBodyIndex(r.body[k]));
+      const MobilizedBody& p = b.getParentMobilizedBody();
+      int c;
+      if (p.isGround()) c = r.body[k];
+      else if (p.getParentMobilizedBody().isGround()) c = p.getMobilizedBodyIndex();
+      else return st;
+      if (base >= 0 && c != base) return st;
+      base = c;
+    }
+  if (base < 0) return st;
+  st.chassis = &matter_->getMobilizedBody(MobilizedBodyIndex(base));
+  if (st.chassis->getUDotMotionMethod(s) != SimTK::Motion::Free) return st;
+  st.nc = st.chassis->getNumU(s);
+  const int m = int(rows.size());
+  st.entryChild.assign(std::size_t(3) * m, -1);
+  for (int i = 0; i < m; ++i) {
+    const RowEval& r = rows[i];
+    for (int k = 0; k < r.n; ++k) {
+      if (r.body[k] == base) continue;
+      const MobilizedBody& B = matter_->getMobilizedBody(MobilizedBodyIndex(r.body[k]));
+      int e = 0;
+      while (e < int(st.children.size()) && st.children[e].body != &B) ++e;
+      st.entryChild[3 * i + k] = e;
+      if (e == int(st.children.size()))
+        st.children.push_back({&B, B.getNumU(s), B.getUDotMotionMethod(s) != SimTK::Motion::Free});
+    }
+  }
+  for (int i = 0; i < m; ++i)
+    for (int k = 0; k < rows[i].n; ++k) {
+      const int e = st.entryChild[3 * i + k];
+      if (e < 0 || st.children[e].known) continue;
+      for (int j = 0; j <= i; ++j)
+        for (int l = 0; l < rows[j].n; ++l)
+          if (st.entryChild[3 * j + l] == e) st.pairs.push_back({i, k, j, l, e});
+    }
+  st.blocks = true;
+  return st;
+}
+
+// G M^-1 G^T from the articulated-body inertias, when every row touches
+// only the chassis c (a child of Ground) and its children b. With M^-1 in
+// the blocks of the articulated-body algorithm (u_c' = S^-1 (tau_c - L tau_b),
+// u_b' = D^-1 tau_b - L^T u_c', zero velocities):
+//   M^-1 = [ S^-1        -S^-1 L             ]
+//          [ -L^T S^-1   D^-1 + L^T S^-1 L   ]
+// S = H_c^T P_c H_c (the chassis's articulated inertia P_c on its
+// mobilities), D = blockdiag(H_k^T P_k H_k) over the children k,
+// L_k = H_c^T Phi_k P_k H_k D_k^-1 (Phi_k: spatial force at k's origin ->
+// at the chassis's), so that with w_i = g_ic - L g_ib:
+//   A_ij = g_ib^T D^-1 g_jb + w_i^T S^-1 w_j.
+// A prescribed child (its u' known) has zero rows and columns in M^-1
+// (multiplyByMInv's convention): its entries are left out.
+bool ReducedDenseRows::formBlocks(const SimTK::State& s, Work& w) const {
+  using SimTK::MobilizedBody;
+  const Structure& st = getStructure(s, w.rows);
+  if (!st.blocks) return false;
+  const int m = int(w.rows.size()), nc = st.nc;
+  const MobilizedBody& C = *st.chassis;
+  SimTK::SpatialVec Hc[6];
+  double S[36];
+  {
+    const SimTK::ArticulatedInertia& P = matter_->getArticulatedBodyInertia(s, C.getMobilizedBodyIndex());
+    for (int j = 0; j < nc; ++j) Hc[j] = C.getHCol(s, SimTK::MobilizerUIndex(j));
+    for (int j = 0; j < nc; ++j) {
+      const SimTK::SpatialVec X = P * Hc[j];
+      for (int i = j; i < nc; ++i) S[i * 6 + j] = dot(Hc[i], X);
+    }
+    if (!cholesky(S, nc, 6)) return false;
+  }
+  const Vec3 pc = C.getBodyOriginLocation(s);
+  w.blocks.resize(st.children.size());
+  for (std::size_t e = 0; e < st.children.size(); ++e) {
+    const Structure::Child& ch = st.children[e];
+    if (ch.known) continue;
+    ChildBlocks& bb = w.blocks[e];
+    const MobilizedBody& B = *ch.body;
+    const SimTK::ArticulatedInertia& P = matter_->getArticulatedBodyInertia(s, B.getMobilizedBodyIndex());
+    SimTK::SpatialVec H[6], X[6];
+    double D[36];
+    for (int j = 0; j < ch.nu; ++j) {
+      H[j] = B.getHCol(s, SimTK::MobilizerUIndex(j));
+      X[j] = P * H[j];
+    }
+    for (int j = 0; j < ch.nu; ++j)
+      for (int l = j; l < ch.nu; ++l) D[l * 6 + j] = dot(H[l], X[j]);
+    if (!cholesky(D, ch.nu, 6)) return false;
+    for (int j = 0; j < ch.nu; ++j) {  // column j of D^-1
+      double x[6] = {0, 0, 0, 0, 0, 0};
+      x[j] = 1;
+      forwardSolve(D, ch.nu, 6, x);
+      backSolve(D, ch.nu, 6, x);
+      for (int l = 0; l < ch.nu; ++l) bb.Dinv[l][j] = x[l];
+    }
+    const Vec3 rc = B.getBodyOriginLocation(s) - pc;
+    for (int j = 0; j < ch.nu; ++j) {
+      SimTK::SpatialVec Y(Vec3(0), Vec3(0));
+      for (int l = 0; l < ch.nu; ++l) Y += X[l] * bb.Dinv[l][j];  // P H D^-1, at B's origin
+      const SimTK::SpatialVec F(Y[0] + SimTK::cross(rc, Y[1]), Y[1]);  // at the chassis's origin
+      for (int c = 0; c < nc; ++c) bb.L[c][j] = dot(Hc[c], F);
+    }
+  }
+  // t_i = Ls^-1 w_i (S = Ls Ls^T), w_i = g_ic - L g_ib.
+  w.t.assign(std::size_t(m) * 6, 0.0);
+  for (int i = 0; i < m; ++i) {
+    const RowEval& r = w.rows[i];
+    double* t = &w.t[std::size_t(i) * 6];
+    for (int k = 0; k < r.n; ++k) {
+      const int e = st.entryChild[3 * i + k];
+      if (e < 0) t[r.ux[k]] += r.g[k];
+      else if (!st.children[e].known)
+        for (int c = 0; c < nc; ++c) t[c] -= w.blocks[e].L[c][r.ux[k]] * r.g[k];
+    }
+    forwardSolve(S, nc, 6, t);
+  }
+  // A = t t^T + the children's g^T D^-1 g (lower triangle).
+  w.A.assign(std::size_t(m) * m, 0.0);
+  for (int i = 0; i < m; ++i) {
+    const double* ti = &w.t[std::size_t(i) * 6];
+    for (int j = 0; j <= i; ++j) {
+      const double* tj = &w.t[std::size_t(j) * 6];
+      double a = 0;
+      for (int c = 0; c < nc; ++c) a += ti[c] * tj[c];
+      w.A[i * m + j] = a;
+    }
+  }
+  for (const Structure::Pair& p : st.pairs) {
+    const RowEval &ri = w.rows[p.i], &rj = w.rows[p.j];
+    w.A[p.i * m + p.j] += ri.g[p.k] * rj.g[p.l] * w.blocks[p.child].Dinv[ri.ux[p.k]][rj.ux[p.l]];
+  }
+  return true;
+}
+
+SimTK::Matrix ReducedDenseRows::calcRowMatrix(const SimTK::State& s, bool byProducts) const {
+  Work w;
+  evalRows(s, w.rows);
+  if (byProducts) formProducts(s, w);
+  else if (!formBlocks(s, w))
+    throw Error("reduced dense dynamics: the rows touch bodies other than the chassis and its children");
+  const int m = int(w.rows.size());
+  SimTK::Matrix A(m, m);
+  for (int i = 0; i < m; ++i)
+    for (int j = 0; j <= i; ++j) A(i, j) = A(j, i) = w.A[i * m + j];
+  return A;
 }
 
 void ReducedDenseRows::realizeDynamics(const SimTK::State& s) const {
@@ -146,63 +376,32 @@ void ReducedDenseRows::realizeDynamics(const SimTK::State& s) const {
   const auto& mbs = SimTK::MultibodySystem::downcast(matter_->getSystem());
   SimTK::Vector& f = mbs.updMobilityForces(s, SimTK::Stage::Dynamics);
   const SimTK::Vector_<SimTK::SpatialVec>& F = mbs.getRigidBodyForces(s, SimTK::Stage::Dynamics);
-  evalRows(s);
-  const int m = int(rows_.size()), nu = s.getNU();
-  matter_->calcAccelerationIgnoringConstraints(s, f, F, udot0_, A_GB_);
-  Y_.resize(m);
-  v_.resize(nu);
-  v_ = 0;
+  Work& w = updWork(s);
+  evalRows(s, w.rows);
+  const int m = int(w.rows.size());
+  matter_->calcAccelerationIgnoringConstraints(s, f, F, w.udot0, w.A_GB);
+  if (!formBlocks(s, w)) formProducts(s, w);
+  // r = b - G udot0.
+  const double* udot0 = w.udot0.getContiguousScalarData();
+  w.r.assign(m, 0.0);
   for (int i = 0; i < m; ++i) {
-    const RowEval& r = rows_[i];
-    for (int k = 0; k < r.n; ++k) v_[r.u[k]] = r.g[k];
-    matter_->multiplyByMInv(s, v_, Y_[i]);
-    for (int k = 0; k < r.n; ++k) v_[r.u[k]] = 0;
-  }
-  // A = G Y (symmetric positive definite), r = b - G udot0.
-  A_.assign(std::size_t(m) * m, 0.0);
-  r_.assign(m, 0.0);
-  for (int i = 0; i < m; ++i) {
-    const RowEval& ri = rows_[i];
+    const RowEval& ri = w.rows[i];
     double gu = 0;
-    for (int k = 0; k < ri.n; ++k) gu += ri.g[k] * udot0_[ri.u[k]];
-    r_[i] = ri.b - gu;
-    for (int j = 0; j <= i; ++j) {
-      double a = 0;
-      for (int k = 0; k < ri.n; ++k) a += ri.g[k] * Y_[j][ri.u[k]];
-      A_[i * m + j] = a;
-    }
+    for (int k = 0; k < ri.n; ++k) gu += ri.g[k] * udot0[ri.u[k]];
+    w.r[i] = ri.b - gu;
   }
   // Cholesky A = L L^T in place (lower triangle), then the two solves.
-  for (int j = 0; j < m; ++j) {
-    double d = A_[j * m + j];
-    for (int k = 0; k < j; ++k) d -= A_[j * m + k] * A_[j * m + k];
-    if (!(d > 0))
-      throw Error("reduced dense dynamics: the constraint rows are singular at t = " + formatValue(s.getTime()) + " s");
-    d = std::sqrt(d);
-    A_[j * m + j] = d;
-    for (int i = j + 1; i < m; ++i) {
-      double a = A_[i * m + j];
-      for (int k = 0; k < j; ++k) a -= A_[i * m + k] * A_[j * m + k];
-      A_[i * m + j] = a / d;
-    }
-  }
-  for (int i = 0; i < m; ++i) {
-    double a = r_[i];
-    for (int k = 0; k < i; ++k) a -= A_[i * m + k] * r_[k];
-    r_[i] = a / A_[i * m + i];
-  }
-  for (int i = m - 1; i >= 0; --i) {
-    double a = r_[i];
-    for (int k = i + 1; k < m; ++k) a -= A_[k * m + i] * r_[k];
-    r_[i] = a / A_[i * m + i];
-  }
+  if (!cholesky(w.A.data(), m, m))
+    throw Error("reduced dense dynamics: the constraint rows are singular at t = " + formatValue(s.getTime()) + " s");
+  forwardSolve(w.A.data(), m, m, w.r.data());
+  backSolve(w.A.data(), m, m, w.r.data());
   // f += G^T lambda.
   SimTK::Vector& lambda = SimTK::Value<SimTK::Vector>::updDowncast(forces_->updCacheEntry(s, lambdaIndex_)).upd();
   lambda.resize(m);
-  for (int i = 0; i < m; ++i) lambda[i] = r_[i];
+  for (int i = 0; i < m; ++i) lambda[i] = w.r[i];
   for (int i = 0; i < m; ++i) {
-    const RowEval& ri = rows_[i];
-    for (int k = 0; k < ri.n; ++k) f[ri.u[k]] += ri.g[k] * r_[i];
+    const RowEval& ri = w.rows[i];
+    for (int k = 0; k < ri.n; ++k) f[ri.u[k]] += ri.g[k] * w.r[i];
   }
 }
 

@@ -22,13 +22,19 @@
 // loop's), so the equations of motion are the same. Per evaluation, with the
 // applied forces f (every force element's, summed by Simbody) and M, G, b:
 //   udot0 = M^-1 (f - c)                (calcAccelerationIgnoringConstraints)
-//   Y     = M^-1 G^T                    (one multiplyByMInv per row)
-//   (G Y) lambda = b - G udot0          (dense Cholesky, m <= 13)
+//   A     = G M^-1 G^T                  (from the articulated-body inertias:
+//                                        formBlocks in reduced_dense.cpp)
+//   A lambda = b - G udot0              (dense Cholesky, m <= 13)
 // and G^T lambda is added to the mobility forces, so Simbody's own tree
-// solve returns udot = udot0 + Y lambda, which meets G udot = b.
+// solve returns udot = udot0 + M^-1 G^T lambda, which meets G udot = b.
+// A needs no tree pass of its own: every row touches only the chassis (a
+// child of Ground) and its children, where M^-1 is given by the chassis's
+// articulated inertia and each child's (H^T P H) and coupling; rows on other
+// bodies would take one multiplyByMInv per row (calcRowMatrix compares both).
 // A prescribed mobility (the steer body's) is not free: udot0 carries its
 // prescribed u' (calcAccelerationIgnoringConstraints obeys Motions) and
-// multiplyByMInv returns 0 there, so its column of G enters G udot0 only and
+// M^-1 is 0 there (multiplyByMInv's convention; formBlocks leaves it out),
+// so its column of G enters G udot0 only and
 // its share of G^T lambda is carried by the Motion's reaction, as the
 // Simbody row's is.
 //
@@ -43,7 +49,6 @@
 // this force does nothing and the Simbody rows act. Simbody's constraint
 // multipliers are not available in a dense state; the speed hold's force
 // (speed_hold.force_N) is read from this element (speedHoldForce).
-// Not thread-safe (workspace in the object), as ReducedKnuckleMobilizer.
 #include <memory>
 #include <vector>
 
@@ -109,16 +114,70 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   /// realizeDynamics of its forces once the sums are complete): adds G^T lambda.
   void realizeDynamics(const SimTK::State& s) const override;
 
+ /// G M^-1 G^T of the rows in `s` (Stage::Dynamics of a dense state), by
+  /// the articulated-body blocks (`byProducts` false, what realizeDynamics
+  /// uses when the rows' bodies allow it) or by one multiplyByMInv per row
+  /// (true): two independent ways, for tests.
+  SimTK::Matrix calcRowMatrix(const SimTK::State& s, bool byProducts) const;
+
  private:
-  /// One row: sparse G (u index, coefficient), the right side b of G udot = b
-  /// (with the Baumgarte terms), and the errors.
+  /// One row: sparse G (u index, coefficient, mobilized body, its mobility),
+  /// the right side b of G udot = b (with the Baumgarte terms), and the errors.
   struct RowEval {
     int n = 0;
     int u[3];
     double g[3];
+    int body[3];  ///< MobilizedBodyIndex of u[k]
+    int ux[3];    ///< u[k]'s index among its mobilizer's mobilities
     double b = 0, perr = 0, verr = 0;
   };
-  void evalRows(const SimTK::State& s) const;
+  /// Which bodies the rows touch (Stage::Instance: the speed holds released
+  /// change the rows), computed on the first evaluation after a change.
+  struct Structure {
+    /// Every row touches only the chassis (a child of Ground, u' free) and
+    /// its children: formBlocks applies.
+    bool blocks = false;
+    const SimTK::MobilizedBody* chassis = nullptr;
+    int nc = 0;  ///< the chassis's mobilities
+    struct Child {
+      const SimTK::MobilizedBody* body;
+      int nu;
+      bool known;  ///< prescribed u': M^-1 is 0 on its mobilities
+    };
+    std::vector<Child> children;
+    std::vector<int> entryChild;  ///< per row entry (3 per row): index into children, -1 the chassis
+    /// Entries (row i, entry k) and (row j, entry l), i >= j, on the same
+    /// free child: the terms of g_ib^T D^-1 g_jb.
+    struct Pair {
+      int i, k, j, l, child;
+    };
+    std::vector<Pair> pairs;
+  };
+  /// A child's D^-1 = (H^T P H)^-1 (H its hinge matrix in Ground at its
+  /// origin, P its articulated-body inertia) and L = H_c^T Phi P H D^-1 (the
+  /// chassis's share, H_c the chassis's hinge matrix, Phi the shift to its
+  /// origin).
+  struct ChildBlocks {
+    double Dinv[6][6];
+    double L[6][6];  ///< L[c][j]: chassis mobility c, the child's mobility j
+  };
+  /// Per-state workspace (a cache entry; no buffers shared between states).
+  struct Work {
+    std::vector<RowEval> rows;
+    SimTK::Vector udot0, v;
+    std::vector<SimTK::Vector> Y;
+    SimTK::Vector_<SimTK::SpatialVec> A_GB;
+    std::vector<double> A, r, t;
+    std::vector<ChildBlocks> blocks;
+  };
+  void evalRows(const SimTK::State& s, std::vector<RowEval>& rows) const;
+  Work& updWork(const SimTK::State& s) const;
+  const Structure& getStructure(const SimTK::State& s, const std::vector<RowEval>& rows) const;
+  /// Fills w.A (lower triangle, m x m) with G M^-1 G^T; false if the rows'
+  /// bodies are not the chassis (a Ground child) and its children (then
+  /// the products are used, or when `byProducts`).
+  bool formBlocks(const SimTK::State& s, Work& w) const;
+  void formProducts(const SimTK::State& s, Work& w) const;
 
   const SimTK::SimbodyMatterSubsystem* matter_;
   const SimTK::GeneralForceSubsystem* forces_;
@@ -128,12 +187,8 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   mutable SimTK::DiscreteVariableIndex activeIndex_;
   mutable SimTK::DiscreteVariableIndex releasedIndex_;  ///< std::vector<int>: 1 = the k-th hold released
   mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
-  // Workspace.
-  mutable std::vector<RowEval> rows_;
-  mutable SimTK::Vector udot0_, v_;
-  mutable std::vector<SimTK::Vector> Y_;
-  mutable SimTK::Vector_<SimTK::SpatialVec> A_GB_;
-  mutable std::vector<double> A_, r_;
+  mutable SimTK::CacheEntryIndex workIndex_;    ///< Work (Stage::Instance: its contents are scratch)
+  mutable SimTK::CacheEntryIndex structureIndex_;  ///< Structure (Stage::Instance, lazy)
 };
 
 }  // namespace vdyn
