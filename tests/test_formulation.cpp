@@ -70,13 +70,16 @@ double maxAbs(const std::vector<double>& a) {
 
 }  // namespace
 
-// Chapter 3 transient (scenes/ch3_transient.json): RK Merson at 5e-7 keeps
-// the yaw-rate history within 1e-6 (relative to its largest value) of a
-// 1e-10 reference, constrained and dense (ch3_work_precision); so the two
-// histories are within 2e-6 of each other. The auto vehicle runs dense.
+// Chapter 3 transient (scenes/ch3_transient.json), both forms at RK Merson
+// 5e-7 (the scene asks 1e-6, enough for its dense default; the constrained
+// model is less accurate at equal setting): the yaw-rate histories are within
+// 1.54e-6 (constrained) and 3.5e-7 (dense) of a constrained 1e-10 reference,
+// relative to its largest value (measured: vdyn run at 1e-10 and at 5e-7), so
+// within 2e-6 of each other. The auto vehicle runs dense.
 TEST(Formulation, Ch3TransientDenseAgreesWithConstrained) {
-  const FormulationRun con = runFormulation("scenes/ch3_transient.json", "constrained");
-  const FormulationRun au = runFormulation("scenes/ch3_transient.json", "auto");
+  const std::vector<Override> acc = {{"analysis.integrator.accuracy", 5e-7}};
+  const FormulationRun con = runFormulation("scenes/ch3_transient.json", "constrained", acc);
+  const FormulationRun au = runFormulation("scenes/ch3_transient.json", "auto", acc);
   EXPECT_EQ(con.formulation, "constrained");
   EXPECT_EQ(au.formulation, "dense");
   EXPECT_EQ(au.result.summary["vehicle"]["formulation"], "dense");
@@ -160,12 +163,13 @@ void expectSummaryNear(const FormulationRun& au, const FormulationRun& con, cons
 }  // namespace
 
 // Chapter 3 with Magic Formula tires (scenes/ch3_transient_mf.json, based on
-// ch3_transient.json: RK Merson at 5e-7): the same statement as the linear-
-// slip chapter 3 transient, the histories within 2e-6 of each other
+// ch3_transient.json), both forms at RK Merson 5e-7: the same statement as the
+// linear-slip chapter 3 transient, the histories within 2e-6 of each other
 // (relative to their largest value). The auto vehicle runs dense.
 TEST(Formulation, Ch3TransientMagicFormulaDenseAgreesWithConstrained) {
-  const FormulationRun con = runFormulation("scenes/ch3_transient_mf.json", "constrained");
-  const FormulationRun au = runFormulation("scenes/ch3_transient_mf.json", "auto");
+  const std::vector<Override> acc = {{"analysis.integrator.accuracy", 5e-7}};
+  const FormulationRun con = runFormulation("scenes/ch3_transient_mf.json", "constrained", acc);
+  const FormulationRun au = runFormulation("scenes/ch3_transient_mf.json", "auto", acc);
   EXPECT_EQ(au.formulation, "dense");
   const Table &tc = tableOf(con.result, "history"), &ta = tableOf(au.result, "history");
   for (const char* c : {"chassis.yaw_rate_rad_s", "chassis.roll_rad", "chassis.side_slip_rad"}) {
