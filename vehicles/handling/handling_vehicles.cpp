@@ -4,6 +4,7 @@
 #include <cmath>
 #include <sstream>
 
+#include "vdyn/core/equilibrium.h"
 #include "vdyn/core/text.h"
 #include "vdyn/vehicles/bicycle.h"
 #include "vdyn/vehicles/wheeled_vehicle.h"
@@ -265,11 +266,15 @@ VehicleReport makeQuarterCarReport(const BuiltScene& built, const std::vector<do
   const QuarterCar& car = built.vehicleAs<QuarterCar>();
   const QuarterCarParams& params = car.params();
   const Scene& sc = built.scene();
-  SimTK::State s = built.vehicle->makeInitialState(0.0);
+  // The rest pose the scene's initial state has (QuarterCar::makeInitialState),
+  // solved here so the report gives its iteration count.
+  SimTK::State s = car.makeInitialState(false);
+  const StaticEquilibriumResult eq = solveStaticEquilibrium(sc, s, car.ineffectiveMobilizers());
   sc.getSystem().realize(s, SimTK::Stage::Velocity);
   VehicleReport rep;
   rep.vehicle = "quarter_car";
   rep.method = "solveStaticEquilibrium (core)";
+  rep.iterations = eq.iterations;
   const std::string fzName = [&] {
     for (const auto& n : sc.getOutputNames())
       if (n.size() > 5 && n.substr(n.size() - 5) == ".Fz_N") return n;
