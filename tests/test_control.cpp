@@ -510,7 +510,7 @@ TEST(RearSteer, NonlinearKrSaturatesBeyondTheFittedFrontAngles) {
     // Derivatives against central differences, inside, across and beyond dm.
     for (double f : {0.5, 0.999, 1.0, 1.001, 1.3, 2.0, 4.0, 10.0}) {
       for (double sgn : {-1.0, 1.0}) {
-        const double df = sgn * f * m, h = 1e-6 * m;
+        const double df = sgn * f * m, h = 1e-7 * m;
         const KrTable::Rear r = t.calcRear(U, df), p = t.calcRear(U, df + h), q = t.calcRear(U, df - h);
         EXPECT_NEAR(r.rear_rad, r.kr * df, 1e-15);
         EXPECT_NEAR(r.slope, (p.rear_rad - q.rear_rad) / (2 * h), 1e-7 * (1 + std::abs(r.slope))) << U << " " << f;
@@ -551,12 +551,14 @@ TEST(RearSteer, NonlinearKrSaturatesBeyondTheFittedFrontAngles) {
   auto dfd = [](double x) { return 0.2 * std::cos(x); };
   auto dfdd = [](double x) { return -0.2 * std::sin(x); };
   auto target = [&](double x) { return st.calcTarget(12.0, df(x), dfd(x), dfdd(x)); };
-  const double h = 1e-5;
+  const double h = 1e-6;
   for (double x = -3.0; x < 3.0; x += 0.0917) {
     const RearSteerTarget r = target(x);
     EXPECT_EQ(r.kr, t.calcRear(12.0, df(x)).kr);
-    EXPECT_NEAR(r.rate_rad_s, (target(x + h).angle_rad - target(x - h).angle_rad) / (2 * h), 1e-9) << x;
-    EXPECT_NEAR(r.accel_rad_s2, (target(x + h).rate_rad_s - target(x - h).rate_rad_s) / (2 * h), 1e-8) << x;
+    EXPECT_NEAR(r.rate_rad_s, (target(x + h).angle_rad - target(x - h).angle_rad) / (2 * h), 1e-7 * (1 + std::abs(r.rate_rad_s))) << x;
+    EXPECT_NEAR(r.accel_rad_s2, (target(x + h).rate_rad_s - target(x - h).rate_rad_s) / (2 * h),
+                1e-7 * (1 + std::abs(r.accel_rad_s2)))
+        << x;
   }
   // The table's checks name the file and key.
   auto table = [](const Json& fit) {

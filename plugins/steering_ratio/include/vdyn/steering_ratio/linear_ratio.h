@@ -113,8 +113,12 @@ struct KrTable {
   using Row = RatioFit;
   std::vector<Row> rows;
   /// G / (1 - Kr(dm)) above: beyond the fitted angles Kr moves at most this
-  /// fraction of the way from Kr(dm) to 1 (dimensionless, 0 < f < 1).
-  static constexpr double kSaturationFraction = 0.5;
+  /// fraction of the way from Kr(dm) to 1 (dimensionless, 0 < f < 1). Small:
+  /// the fit says nothing beyond dm, so Kr stays near Kr(dm) (within 0.07 of it
+  /// for kr_table.json). With 0.5 Kr reached 0.67 at 12 m/s, in phase enough
+  /// that the steady turn from straight running had no fold below 0.5 rad at
+  /// 11-12 m/s (the limit map's fold curve ended in a cusp at 10.98 m/s).
+  static constexpr double kSaturationFraction = 0.1;
 
   /// Throws Error naming `where`[i] and the value unless there is a row, every
   /// number is finite, speeds are >= 0 and ascending, front_max_deg is > 0 and
