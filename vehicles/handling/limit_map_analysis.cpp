@@ -5,7 +5,8 @@
 // one figure). Tables limit_map_<strategy>.csv; the plot limit_map.png:
 // (speed, front angle) and (speed, lateral acceleration), each with the
 // stable region (the branch from straight running below the fold, where the
-// fold's other eigenvalues are stable) shaded.
+// fold's other eigenvalues are stable and the fold is the first one from
+// straight running, limit_map.h step 3) shaded.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,6 +43,8 @@ Json pointJson(const LimitMapPoint& p) {
             {"yaw_rate_rad_s", p.yaw_rate_rad_s},
             {"side_slip_deg", p.side_slip_rad / kDeg},
             {"fold_test", p.fold_test},
+            {"folds_at_speed", p.folds_at_speed},
+            {"first_fold", p.first_fold},
             {"arclength_m_s", p.arclength}};
   if (p.have_eigenvalues) {
     Json e = Json::array();
@@ -117,19 +120,21 @@ class LimitMapAnalysis : public Analysis {
       const std::string table = "limit_map_" + strategy;
       Table t;
       t.columns = {"speed_m_s", "front_deg", "rear_deg", "lateral_accel_m_s2", "yaw_rate_rad_s", "side_slip_deg",
-                   "fold_test", "arclength_m_s", "stable_side", "critical_re_per_s", "critical_im_per_s",
+                   "fold_test", "arclength_m_s", "folds_at_speed", "first_fold", "stable_side", "critical_re_per_s", "critical_im_per_s",
                    "other_least_damped_re_per_s", "other_least_damped_im_per_s", "stable_front_deg",
                    "stable_lateral_accel_m_s2"};
       Json pts = Json::array();
       double ayMin = INFINITY, ayMax = -INFINITY;
-      int stableSide = 0;
+      int stableSide = 0, notFirst = 0;
       for (const auto& p : m.points) {
-        const bool st = p.stable_side == "straight_running";
-        stableSide += st;
+        const bool st = p.stable_side == "straight_running" && p.first_fold;  // shaded
+        stableSide += p.stable_side == "straight_running";
+        notFirst += !p.first_fold;
         ayMin = std::min(ayMin, std::abs(p.lateral_accel_m_s2));
         ayMax = std::max(ayMax, std::abs(p.lateral_accel_m_s2));
         t.rows.push_back({p.speed_m_s, p.front_rad / kDeg, p.rear_rad / kDeg, p.lateral_accel_m_s2, p.yaw_rate_rad_s,
-                          p.side_slip_rad / kDeg, p.fold_test, p.arclength, p.have_eigenvalues ? double(st) : NAN,
+                          p.side_slip_rad / kDeg, p.fold_test, p.arclength, double(p.folds_at_speed),
+                          double(p.first_fold), p.have_eigenvalues ? double(p.stable_side == "straight_running") : NAN,
                           p.have_eigenvalues ? p.critical.real() : NAN, p.have_eigenvalues ? p.critical.imag() : NAN,
                           p.have_eigenvalues ? p.least_damped_other.real() : NAN,
                           p.have_eigenvalues ? p.least_damped_other.imag() : NAN, st ? p.front_rad / kDeg : NAN,
@@ -149,6 +154,7 @@ class LimitMapAnalysis : public Analysis {
                         {"hopf_at_start", hopf},
                         {"fold_curve_points", m.points.size()},
                         {"stable_side_points", stableSide},
+                        {"points_not_first_fold", notFirst},
                         {"speed_range_m_s", {m.points.front().speed_m_s, m.points.back().speed_m_s}},
                         {"fold_lateral_accel_range_m_s2", {ayMin, ayMax}},
                         {"curve_special_points", special},
