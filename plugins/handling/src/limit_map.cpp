@@ -224,11 +224,17 @@ LimitMapResult runLimitMap(const HandlingVehicle& v, const LimitMapSettings& set
   quiet.stability = false;
   for (auto& p : out.points) {
     const double U = p.speed_m_s;
+    // Segments of the curve (as drawn) whose closed speed range holds U, less
+    // the interior points at U that the curve passes through monotonically
+    // (counted by both their segments); a turning point at U counts twice.
     int crossings = 0;
-    for (std::size_t j = 0; j + 1 < out.points.size(); ++j) {
-      const double a = out.points[j].speed_m_s, b = out.points[j + 1].speed_m_s;
-      crossings += (a <= U && U < b) || (b <= U && U < a);
+    const auto& q = out.points;
+    for (std::size_t j = 0; j + 1 < q.size(); ++j) {
+      const double a = q[j].speed_m_s, b = q[j + 1].speed_m_s;
+      crossings += std::min(a, b) <= U && U <= std::max(a, b);
     }
+    for (std::size_t j = 1; j + 1 < q.size(); ++j)
+      crossings -= q[j].speed_m_s == U && (q[j - 1].speed_m_s - U) * (q[j + 1].speed_m_s - U) < 0;
     p.folds_at_speed = std::max(crossings, 1);
     if (p.folds_at_speed > 1)
       p.first_fold = std::abs(locateFrontSteerFold(v, solver, U, quiet) - p.front_rad) <= set.first_fold_tolerance_rad;
