@@ -138,3 +138,28 @@ TEST(LimitMap, NonlinearFourWsFoldsAreLeftTurnsAndFirstFoldsAgree) {
   EXPECT_NEAR(m.start_fold_front_rad * 180 / M_PI, 8.617, 0.001);
   EXPECT_NEAR(m.points.front().lateral_accel_m_s2, 7.251, 0.001);
 }
+
+// A fold curve whose corrector cannot converge (g_tolerance far below
+// rounding) is an error naming the strategy, the speed and front angle last
+// evaluated and the continuation's reason, not a truncated map.
+TEST(LimitMap, CurveThatCannotPassAPointIsANamedError) {
+  const Json scene = {{"name", "limit_map_error_test"},
+                      {"vehicle", {{"type", "fourws"}, {"data", "appendix_a.json"}, {"initial_speed_m_s", 10.0}}},
+                      {"analysis", {{"type", "limit_map"}}}};
+  auto b = buildHandlingScene(SceneDescription::fromJson(scene, "", standardRegistry()), HandlingSetup{});
+  LimitMapSettings set;
+  set.speed_start_m_s = 10;
+  set.speed_max_m_s = 12;
+  set.stability = false;
+  set.g_tolerance = 1e-300;
+  std::string what;
+  try {
+    runLimitMap(b->vehicle, set);
+  } catch (const Error& e) {
+    what = e.what();
+  }
+  std::printf("%s\n", what.c_str());
+  EXPECT_EQ(what.rfind("limit map (2ws): the fold curve could not pass speed 1", 0), 0u) << what;
+  EXPECT_NE(what.find(" m/s, front angle 7."), std::string::npos) << what;  // the 7.735 deg fold at 10 m/s
+  EXPECT_NE(what.find("deg (the last point evaluated): "), std::string::npos) << what;
+}
