@@ -2,7 +2,9 @@
 // (plugins/handling limit_map.h) on the scene's built scene, prepared for the
 // open-loop tests (buildHandlingScene: programmable steering, speed hold), for
 // the scene's rear_strategy and any also_rear_strategies (one curve each, in
-// one figure). Tables limit_map_<strategy>.csv; the plot limit_map.png:
+// one figure). Tables limit_map_<strategy>.csv (the fold curve) and
+// limit_map_<strategy>_limit.csv (its stable first folds from straight
+// running, sorted by speed: the limit); the plot limit_map.png:
 // (speed, front angle) and (speed, lateral acceleration), each with the
 // stable region (the branch from straight running below the fold, where the
 // fold's other eigenvalues are stable and the fold is the first one from
@@ -58,10 +60,12 @@ Json pointJson(const LimitMapPoint& p) {
 }
 
 /// The figure, two panels: (speed, front angle) and (speed, lateral
-/// acceleration), a fold curve per strategy with its stable region shaded
-/// (filled down to 0; a strategy without a stable point has no shading:
-/// renderPlots leaves out a series without points).
-PlotSpec mapFigure(const AnalysisResult& res) {
+/// acceleration), a fold curve per strategy (table limit_map_<strategy>) with
+/// its stable region shaded (filled down to 0 under the table
+/// limit_map_<strategy>_limit: the stable first folds sorted by speed; a
+/// strategy without a stable point has no shading: renderPlots leaves out a
+/// series without points).
+PlotSpec mapFigure(const std::vector<std::string>& strategies) {
   static const char* const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
   PlotSpec f;
   f.name = "limit_map";
@@ -72,11 +76,11 @@ PlotSpec mapFigure(const AnalysisResult& res) {
     PlotSpec p;
     p.xlabel = "speed U0 (m/s)";
     p.ylabel = y == "front_deg" ? "front road-wheel angle at the fold (deg)" : "lateral acceleration at the fold (m/s^2)";
-    for (std::size_t i = 0; i < res.tables.size(); ++i) {
-      const std::string& name = res.tables[i].first;
-      const std::string label = name.substr(std::string("limit_map_").size());
+    for (std::size_t i = 0; i < strategies.size(); ++i) {
+      const std::string& label = strategies[i];
+      const std::string name = "limit_map_" + label;
       const std::string c = std::string(" lc rgb '") + colours[i % 4] + "'";
-      PlotSeries stable{name, "speed_m_s", "stable_" + y, label + ": stable"};
+      PlotSeries stable{name + "_limit", "speed_m_s", y, label + ": stable"};
       stable.style = "with filledcurves y1=0 fs transparent solid 0.2 noborder" + c;
       PlotSeries fold{name, "speed_m_s", y, label + ": fold"};
       fold.style = "with linespoints lw 2 pt 7 ps 0.6" + c;
@@ -142,6 +146,16 @@ class LimitMapAnalysis : public Analysis {
         pts.push_back(pointJson(p));
       }
       res.tables.push_back({table, t});
+      // The limit: the stable first folds, sorted by speed (the shading).
+      std::vector<const LimitMapPoint*> lim;
+      for (const auto& p : m.points)
+        if (p.first_fold && p.stable_side == "straight_running") lim.push_back(&p);
+      std::stable_sort(lim.begin(), lim.end(),
+                       [](const LimitMapPoint* a, const LimitMapPoint* b) { return a->speed_m_s < b->speed_m_s; });
+      Table tl;
+      tl.columns = {"speed_m_s", "front_deg", "lateral_accel_m_s2"};
+      for (const auto* p : lim) tl.rows.push_back({p->speed_m_s, p->front_rad / kDeg, p->lateral_accel_m_s2});
+      res.tables.push_back({table + "_limit", tl});
       Json hopf = Json::array(), special = Json::array();
       for (const auto& p : m.hopf_at_start) hopf.push_back(pointJson(p));
       for (const auto& p : m.curve_special) special.push_back(pointJson(p));
@@ -169,7 +183,7 @@ class LimitMapAnalysis : public Analysis {
                         {"cpu_time_s", m.cpu_time_s},
                         {"points", pts}};
     }
-    res.plots.push_back(mapFigure(res));
+    res.plots.push_back(mapFigure(strategies_));
     res.summary = {{"strategies", strategies_},
                    {"maps", maps},
                    {"wall_time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count()},
