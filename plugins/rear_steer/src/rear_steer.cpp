@@ -56,9 +56,9 @@ void registerRearSteerStrategies(PluginRegistry& registry) {
         if (!c.table) throw Error("rear steer strategy 'nonlinear' needs a Kr coefficient table");
         return std::make_unique<NonlinearKrStrategy>(*c.table);
       },
-      typeInfo("Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1, C2 and front_max_deg interpolated in speed (Table "
-               "8.1); beyond a fit's front_max_deg a C2 saturation of Kr below 1 (KrTable); no keys of its own: the "
-               "rear_steer plugin's kr_table (required)",
+      typeInfo("Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1 and C2 interpolated in speed (Table 8.1); beyond a "
+               "row's front_max_deg its Kr continued by a bounded C2 saturation below 1 and the two rows' laws "
+               "interpolated (KrTable); no keys of its own: the rear_steer plugin's kr_table (required)",
                noFields()));
 }
 
