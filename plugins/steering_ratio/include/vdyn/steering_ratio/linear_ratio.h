@@ -114,10 +114,11 @@ struct KrTable {
   std::vector<Row> rows;
   /// G / (1 - Kr(dm)) above: beyond the fitted angles Kr moves at most this
   /// fraction of the way from Kr(dm) to 1 (dimensionless, 0 < f < 1). Small:
-  /// the fit says nothing beyond dm, so Kr stays near Kr(dm) (within 0.07 of it
-  /// for kr_table.json). With 0.5 Kr reached 0.67 at 12 m/s, in phase enough
-  /// that the steady turn from straight running had no fold below 0.5 rad at
-  /// 11-12 m/s (the limit map's fold curve ended in a cusp at 10.98 m/s).
+  /// the fit says nothing beyond dm, so Kr stays near Kr(dm) (kr_table.json:
+  /// within 0.093 at 6 m/s, 0.066 at 12, 0.037 at 20). With 0.5 Kr reached
+  /// 0.67 at 12 m/s, in phase enough that the steady turn from straight
+  /// running had no fold below 0.5 rad at 11-12 m/s (the limit map's fold
+  /// curve stopped at 10.98 m/s, its step below min_step).
   static constexpr double kSaturationFraction = 0.1;
 
   /// Throws Error naming `where`[i] and the value unless there is a row, every
