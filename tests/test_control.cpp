@@ -478,6 +478,107 @@ TEST(RearSteer, NonlinearTargetDerivativesMatchFiniteDifferences) {
   EXPECT_EQ(TwoWsStrategy().calcTarget(16, 0.1, 0.2, 0.3).angle_rad, 0.0);
 }
 
+TEST(RearSteer, NonlinearKrSaturatesBeyondTheFittedFrontAngles) {
+  // vehicles/data/kr_table.json, fitted up to front_max_deg (40, 7.25, 4.625,
+  // 3.35, 2.2, 1.79 deg at 6-30 m/s). Inside: (8.1), (8.6)-(8.8) bit for bit
+  // as before the saturation; beyond: Kr, its slope and curvature continuous
+  // at dm, Kr < 1 and tending to Kr(dm) + (1 - Kr(dm)) / 2 (KrTable).
+  const KrTable t = KrTable::fromFile(resolveDataPath("kr_table.json"));
+  ASSERT_EQ(t.rows.size(), 6u);
+  EXPECT_EQ(t.rows[1].front_max_deg, 7.250000000000001);
+  const double perDeg = 180 / SimTK::Pi;
+  for (double U : {4.0, 6.0, 9.0, 12.0, 13.7, 16.0, 18.0, 20.0, 22.0, 25.0, 30.0, 35.0}) {
+    const KrTable::Row c = t.calcAt(U);
+    const double k2 = c.c2_per_deg2 * perDeg * perDeg, m = c.front_max_deg / perDeg;
+    // Inside the fitted angles: the former expressions exactly.
+    for (double f = -1; f <= 1.0001; f += 0.125) {
+      const double df = f * m;
+      const KrTable::Rear r = t.calcRear(U, df);
+      EXPECT_EQ(r.rear_rad, c.c1 * df + k2 * df * df * df) << U << " " << df;
+      EXPECT_EQ(r.slope, c.c1 + 3 * k2 * df * df);
+      EXPECT_EQ(r.curvature_per_rad, 6 * k2 * df);
+      EXPECT_EQ(r.kr, c.c1 + k2 * df * df);
+    }
+    // Continuity at +-dm: value, slope and curvature from both sides.
+    for (double sgn : {-1.0, 1.0}) {
+      const double e = 1e-9;
+      const KrTable::Rear in = t.calcRear(U, sgn * m * (1 - e)), out = t.calcRear(U, sgn * m * (1 + e));
+      EXPECT_NEAR(in.kr, out.kr, 3 * e * std::abs(in.slope - in.kr) + 1e-15) << U;  // dKr/d delta_f = (slope - Kr) / delta_f
+      EXPECT_NEAR(in.slope, out.slope, 3 * e * m * std::abs(in.curvature_per_rad) + 1e-15) << U;
+      EXPECT_NEAR(in.curvature_per_rad, out.curvature_per_rad, 1e-6 * (1 + std::abs(in.curvature_per_rad))) << U;
+    }
+    // Derivatives against central differences, inside, across and beyond dm.
+    for (double f : {0.5, 0.999, 1.0, 1.001, 1.3, 2.0, 4.0, 10.0}) {
+      for (double sgn : {-1.0, 1.0}) {
+        const double df = sgn * f * m, h = 1e-7 * m;
+        const KrTable::Rear r = t.calcRear(U, df), p = t.calcRear(U, df + h), q = t.calcRear(U, df - h);
+        EXPECT_NEAR(r.rear_rad, r.kr * df, 1e-15);
+        EXPECT_NEAR(r.slope, (p.rear_rad - q.rear_rad) / (2 * h), 1e-7 * (1 + std::abs(r.slope))) << U << " " << f;
+        EXPECT_NEAR(r.curvature_per_rad, (p.slope - q.slope) / (2 * h), 1e-5 * (1 + std::abs(r.curvature_per_rad)))
+            << U << " " << f;
+      }
+    }
+    // Bounded below 1, monotone beyond dm, towards the documented limit (at
+    // a table speed; between two, the interpolation of the two limits).
+    const KrTable::Row *lo = &t.rows.front(), *hi = lo;
+    for (const auto& row : t.rows) {
+      if (row.speed_m_s <= U) lo = &row;
+      if (row.speed_m_s >= U && hi->speed_m_s < U) hi = &row;
+    }
+    if (U > t.rows.back().speed_m_s) hi = lo;
+    const double wt = hi == lo ? 0 : (U - lo->speed_m_s) / (hi->speed_m_s - lo->speed_m_s);
+    auto lim = [](const KrTable::Row& r) {
+      const double km = r.evaluate(r.front_max_deg);
+      return km + KrTable::kSaturationFraction * (1 - km);
+    };
+    const double km = c.c1 + k2 * m * m, limit = lim(*lo) + wt * (lim(*hi) - lim(*lo));
+    double prev = km;
+    for (double df = m; df < 1.6; df += 0.002) {
+      const double kr = t.calcRear(U, df).kr;
+      EXPECT_LT(kr, 1.0) << U << " " << df;
+      EXPECT_LE(kr, limit + 1e-15);
+      EXPECT_GE(kr, prev - 1e-15);
+      prev = kr;
+    }
+    EXPECT_NEAR(t.calcRear(U, 1e3).kr, limit, 1e-12) << U;
+    std::printf("U %5.1f m/s: front_max %6.3f deg, Kr(dm) %.4f, Kr(2 dm) %.4f, limit %.4f\n", U, c.front_max_deg, km,
+                t.calcRear(U, 2 * m).kr, limit);
+  }
+  // The strategy's acceleration-level target (8.7)-(8.8) with the saturation:
+  // delta_f(t) = 0.2 sin(t) at 12 m/s crosses dm = 7.25 deg = 0.1265 rad.
+  const NonlinearKrStrategy st(t);
+  auto df = [](double x) { return 0.2 * std::sin(x); };
+  auto dfd = [](double x) { return 0.2 * std::cos(x); };
+  auto dfdd = [](double x) { return -0.2 * std::sin(x); };
+  auto target = [&](double x) { return st.calcTarget(12.0, df(x), dfd(x), dfdd(x)); };
+  const double h = 1e-6;
+  for (double x = -3.0; x < 3.0; x += 0.0917) {
+    const RearSteerTarget r = target(x);
+    EXPECT_EQ(r.kr, t.calcRear(12.0, df(x)).kr);
+    EXPECT_NEAR(r.rate_rad_s, (target(x + h).angle_rad - target(x - h).angle_rad) / (2 * h), 1e-7 * (1 + std::abs(r.rate_rad_s))) << x;
+    EXPECT_NEAR(r.accel_rad_s2, (target(x + h).rate_rad_s - target(x - h).rate_rad_s) / (2 * h),
+                1e-7 * (1 + std::abs(r.accel_rad_s2)))
+        << x;
+  }
+  // The table's checks name the file and key.
+  auto table = [](const Json& fit) {
+    KrTable::fromParams(ParamReader::fromJson({{"delta_f_unit", "deg"}, {"fit", fit}}, "kr.json"));
+  };
+  EXPECT_EQ(test::errorOf([&] { table({{{"speed_m_s", 10}, {"c1", 0}, {"c2_per_deg2", 0}, {"front_max_deg", 0.0}}}); }),
+            "kr.json: fit[0].front_max_deg: must be > 0, got 0");
+  EXPECT_EQ(test::errorOf([&] {
+              table({{{"speed_m_s", 10}, {"c1", 0}, {"c2_per_deg2", 0}, {"front_max_deg", 5.0}},
+                     {{"speed_m_s", 20}, {"c1", 0}, {"c2_per_deg2", 0}}});
+            }),
+            "kr.json: fit[1].front_max_deg: must be given in every row or in none (kr.json: fit[0] has it)");
+  EXPECT_EQ(test::errorOf([&] { table({{{"speed_m_s", 10}, {"c1", 0.5}, {"c2_per_deg2", 0.02}, {"front_max_deg", 5.0}}}); }),
+            "kr.json: fit[0]: Kr = c1 + c2_per_deg2 delta_f^2 reaches 1 up to front_max_deg, must stay < 1 (the "
+            "continuation beyond stays below 1)");
+  EXPECT_EQ(test::errorOf([&] { table({{{"speed_m_s", 10}, {"c1", 0}, {"c2_per_deg2", 0}, {"front_max_deg", "a"}}}); })
+                .find("kr.json: fit[0].front_max_deg"),
+            0u);
+}
+
 namespace {
 /// 4WS at 16 m/s with the path controller on a 2 m lane change, the rear axle
 /// starting 0.01 rad off its target under `strategy`; returns the tracking

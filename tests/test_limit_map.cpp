@@ -80,3 +80,86 @@ TEST(LimitMap, FoldCurveAgreesWithOneParameterFolds) {
     EXPECT_LT(std::abs(p.fold_test), 1e-5 * m.bordering.second_singular_value);
   }
 }
+
+// The nonlinear 4WS strategy (kr_table.json, Kr saturated beyond each fit's
+// front_max_deg) over its scene's speeds, 10-22 m/s. The quadratic (8.1)
+// extrapolated passed Kr = 1 beyond the fitted angles (the turn reversed) and
+// the map's folds had a_y < 0; now every point of the fold curve is a left
+// turn, a_y > 0, Kr < 1. The curve turns in speed four times (near 12.82,
+// 12.09, 17.32 and 16.12 m/s), so 12.1-12.8 and 16.1-17.3 m/s have three
+// folds each: there the points are marked first_fold by the one-parameter
+// fold; elsewhere each third point is checked against it here.
+TEST(LimitMap, NonlinearFourWsFoldsAreLeftTurnsAndFirstFoldsAgree) {
+  const Json scene = {{"name", "limit_map_nonlinear_test"},
+                      {"vehicle", {{"type", "fourws"}, {"data", "appendix_a.json"}, {"initial_speed_m_s", 10.0}}},
+                      {"analysis", {{"type", "limit_map"}}}};
+  HandlingSetup setup;
+  setup.rear_strategy = "nonlinear";
+  auto b = buildHandlingScene(SceneDescription::fromJson(scene, "", standardRegistry()), setup);
+  LimitMapSettings set;  // limit_map_4ws_nonlinear.json's, without eigenvalues
+  set.speed_start_m_s = 10;
+  set.speed_max_m_s = 22;
+  set.speed_step_m_s = 2;
+  set.stability = false;
+  const LimitMapResult m = runLimitMap(b->vehicle, set);
+  ASSERT_GE(m.points.size(), 30u);
+  EXPECT_GE(m.points.back().speed_m_s, 22.0);  // the whole range
+  EXPECT_EQ(m.stop_reason, "lambda_range");
+  int curveFolds = 0;
+  for (const auto& sp : m.curve_special) curveFolds += sp.kind == "fold";
+  EXPECT_EQ(curveFolds, 4);
+  const Scene& sc = *b->vehicle.scene;
+  SteadyStateSolver solver(sc, makeSteadyTurningProblem(sc, "chassis", b->vehicle.wheel_bodies, 0.0));
+  int checked = 0, several = 0, first = 0;
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const LimitMapPoint& p = m.points[i];
+    EXPECT_GT(p.front_rad, 0.0) << "speed " << p.speed_m_s;
+    EXPECT_GT(p.lateral_accel_m_s2, 5.0) << "speed " << p.speed_m_s;
+    EXPECT_LT(p.lateral_accel_m_s2, 7.5) << "speed " << p.speed_m_s;
+    EXPECT_GT(p.yaw_rate_rad_s, 0.0) << "speed " << p.speed_m_s;
+    EXPECT_LT(p.rear_rad / p.front_rad, 1.0) << "speed " << p.speed_m_s;
+    several += p.folds_at_speed > 1;
+    first += p.folds_at_speed > 1 && p.first_fold;
+    if (p.folds_at_speed == 1) {
+      EXPECT_TRUE(p.first_fold);
+      if (i % 3 == 0) {
+        EXPECT_NEAR(p.front_rad, locateFrontSteerFold(b->vehicle, solver, p.speed_m_s, set), 1e-7)
+            << "speed " << p.speed_m_s;
+        ++checked;
+      }
+    }
+  }
+  EXPECT_GE(checked, 8);
+  EXPECT_GT(several, 0);
+  EXPECT_GT(first, 0);
+  EXPECT_LT(first, several);  // at those speeds some folds are not the first one
+  // The start: 10 m/s, front 8.617 deg (beyond the 7.25 deg fitted at 12 m/s:
+  // on the saturation), a_y 7.25 m/s^2.
+  EXPECT_NEAR(m.start_fold_front_rad * 180 / M_PI, 8.617, 0.001);
+  EXPECT_NEAR(m.points.front().lateral_accel_m_s2, 7.251, 0.001);
+}
+
+// A fold curve whose corrector cannot converge (g_tolerance far below
+// rounding) is an error naming the strategy, the speed and front angle last
+// evaluated and the continuation's reason, not a truncated map.
+TEST(LimitMap, CurveThatCannotPassAPointIsANamedError) {
+  const Json scene = {{"name", "limit_map_error_test"},
+                      {"vehicle", {{"type", "fourws"}, {"data", "appendix_a.json"}, {"initial_speed_m_s", 10.0}}},
+                      {"analysis", {{"type", "limit_map"}}}};
+  auto b = buildHandlingScene(SceneDescription::fromJson(scene, "", standardRegistry()), HandlingSetup{});
+  LimitMapSettings set;
+  set.speed_start_m_s = 10;
+  set.speed_max_m_s = 12;
+  set.stability = false;
+  set.g_tolerance = 1e-300;
+  std::string what;
+  try {
+    runLimitMap(b->vehicle, set);
+  } catch (const Error& e) {
+    what = e.what();
+  }
+  std::printf("%s\n", what.c_str());
+  EXPECT_EQ(what.rfind("limit map (2ws): the fold curve could not pass speed 1", 0), 0u) << what;
+  EXPECT_NE(what.find(" m/s, front angle 7."), std::string::npos) << what;  // the 7.735 deg fold at 10 m/s
+  EXPECT_NE(what.find("deg (the last point evaluated): "), std::string::npos) << what;
+}

@@ -77,12 +77,15 @@ TEST(SteeringRatio, FitRecoversAQuadraticAndTheTableRoundTrips) {
   EXPECT_NEAR(f.c2_per_deg2, -0.004, 2e-5);
   EXPECT_NEAR(f.rms_residual, 1e-4, 2e-5);
   EXPECT_EQ(f.points, int(d.size()));
+  EXPECT_EQ(f.front_max_deg, 3.0);  // the largest |front angle| fitted
+  EXPECT_EQ(fitRatio(12, {1, -5.5, 3}, {0.1, 0.3, 0.2}).front_max_deg, 5.5);
   RatioFit g = f;
   g.speed_m_s = 6.0;
   const std::string text = formatRatioTable({f, g});
   EXPECT_EQ(text.substr(0, 43), "{\n  \"delta_f_unit\": \"deg\",\n  \"fit\": [\n    {");
   EXPECT_LT(text.find("\"speed_m_s\""), text.find("\"c1\""));  // the documented key order
   EXPECT_LT(text.find("\"rms_residual\""), text.find("\"points\""));
+  EXPECT_LT(text.find("\"points\""), text.find("\"front_max_deg\""));
   const Json t = Json::parse(text);
   EXPECT_EQ(t["delta_f_unit"], "deg");
   EXPECT_EQ(t["fit"][0]["speed_m_s"], 6.0);  // ascending
@@ -92,6 +95,8 @@ TEST(SteeringRatio, FitRecoversAQuadraticAndTheTableRoundTrips) {
   ASSERT_EQ(back.size(), 2u);
   EXPECT_EQ(back[1].c2_per_deg2, f.c2_per_deg2);
   EXPECT_EQ(back[1].points, f.points);
+  EXPECT_EQ(back[1].front_max_deg, 3.0);
+  EXPECT_EQ(formatRatioTable({RatioFit{12.0}}).find("front_max_deg"), std::string::npos);  // not recorded: no key
 }
 
 TEST(SteeringRatio, ErrorsNameTheFieldAndValue) {

@@ -336,12 +336,14 @@ int main(int argc, char** argv) {
       fit.c2_per_deg2 = fj.at("c2_per_deg2").get<double>();
       fit.rms_residual = fj.at("rms_residual").get<double>();
       fit.points = fj.at("points").get<int>();
+      fit.front_max_deg = fj.at("front_max_deg").get<double>();
       fits.push_back(fit);
       fitJson.push_back({{"speed_m_s", U},
                          {"c1", fit.c1},
                          {"c2", fit.c2_per_deg2},
                          {"rms_residual", fit.rms_residual},
                          {"points", fit.points},
+                         {"front_max_deg", fit.front_max_deg},
                          {"infeasible_points", infeasible}});
       perSpeed.push_back({{"speed_m_s", U},
                           {"largest_front_deg", largest},
@@ -354,8 +356,10 @@ int main(int argc, char** argv) {
     f.commit();
     {
       OutputFile fc(out + "/kr_fit.csv");
-      fc << "speed_m_s,c1,c2_per_deg2,rms_residual,points\n";
-      for (const auto& x : fits) fc << x.speed_m_s << ',' << x.c1 << ',' << x.c2_per_deg2 << ',' << x.rms_residual << ',' << x.points << '\n';
+      fc << "speed_m_s,c1,c2_per_deg2,rms_residual,points,front_max_deg\n";
+      for (const auto& x : fits)
+        fc << x.speed_m_s << ',' << x.c1 << ',' << x.c2_per_deg2 << ',' << x.rms_residual << ',' << x.points << ','
+           << x.front_max_deg << '\n';
       fc.commit();
     }
     const std::string table = formatRatioTable(fits);
@@ -363,7 +367,9 @@ int main(int argc, char** argv) {
     if (vm.count("table-copy")) {
       const std::string path = vm["table-copy"].as<std::string>();
       OutputFile tc(path);
-      tc << "// Kr(delta_f) = c1 + c2_per_deg2 delta_f^2 (8.1), delta_f in deg, App. A 4WS vehicle. Regenerate with\n"
+      tc << "// Kr(delta_f) = c1 + c2_per_deg2 delta_f^2 (8.1), delta_f in deg, App. A 4WS vehicle; front_max_deg: the\n"
+            "// largest front angle each fit covers (the nonlinear strategy continues Kr beyond it by a bounded saturation,\n"
+            "// KrTable in linear_ratio.h). Regenerate with\n"
             "//   ./build/bin/ch6_steering_ratio --table-copy vehicles/data/kr_table.json\n"
             "// (the same table, without these lines, is results/ch6_steering_ratio/kr_table.json).\n"
          << table;

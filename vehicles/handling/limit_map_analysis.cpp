@@ -2,10 +2,13 @@
 // (plugins/handling limit_map.h) on the scene's built scene, prepared for the
 // open-loop tests (buildHandlingScene: programmable steering, speed hold), for
 // the scene's rear_strategy and any also_rear_strategies (one curve each, in
-// one figure). Tables limit_map_<strategy>.csv; the plot limit_map.png:
+// one figure). Tables limit_map_<strategy>.csv (the fold curve) and
+// limit_map_<strategy>_limit.csv (its stable first folds from straight
+// running, sorted by speed: the limit); the plot limit_map.png:
 // (speed, front angle) and (speed, lateral acceleration), each with the
 // stable region (the branch from straight running below the fold, where the
-// fold's other eigenvalues are stable) shaded.
+// fold's other eigenvalues are stable and the fold is the first one from
+// straight running, limit_map.h step 3) shaded.
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -42,6 +45,8 @@ Json pointJson(const LimitMapPoint& p) {
             {"yaw_rate_rad_s", p.yaw_rate_rad_s},
             {"side_slip_deg", p.side_slip_rad / kDeg},
             {"fold_test", p.fold_test},
+            {"folds_at_speed", p.folds_at_speed},
+            {"first_fold", p.first_fold},
             {"arclength_m_s", p.arclength}};
   if (p.have_eigenvalues) {
     Json e = Json::array();
@@ -55,10 +60,12 @@ Json pointJson(const LimitMapPoint& p) {
 }
 
 /// The figure, two panels: (speed, front angle) and (speed, lateral
-/// acceleration), a fold curve per strategy with its stable region shaded
-/// (filled down to 0; a strategy without a stable point has no shading:
-/// renderPlots leaves out a series without points).
-PlotSpec mapFigure(const AnalysisResult& res) {
+/// acceleration), a fold curve per strategy (table limit_map_<strategy>) with
+/// its stable region shaded (filled down to 0 under the table
+/// limit_map_<strategy>_limit: the stable first folds sorted by speed; a
+/// strategy without a stable point has no shading: renderPlots leaves out a
+/// series without points).
+PlotSpec mapFigure(const std::vector<std::string>& strategies) {
   static const char* const colours[] = {"#1f77b4", "#d62728", "#2ca02c", "#9467bd"};
   PlotSpec f;
   f.name = "limit_map";
@@ -69,11 +76,11 @@ PlotSpec mapFigure(const AnalysisResult& res) {
     PlotSpec p;
     p.xlabel = "speed U0 (m/s)";
     p.ylabel = y == "front_deg" ? "front road-wheel angle at the fold (deg)" : "lateral acceleration at the fold (m/s^2)";
-    for (std::size_t i = 0; i < res.tables.size(); ++i) {
-      const std::string& name = res.tables[i].first;
-      const std::string label = name.substr(std::string("limit_map_").size());
+    for (std::size_t i = 0; i < strategies.size(); ++i) {
+      const std::string& label = strategies[i];
+      const std::string name = "limit_map_" + label;
       const std::string c = std::string(" lc rgb '") + colours[i % 4] + "'";
-      PlotSeries stable{name, "speed_m_s", "stable_" + y, label + ": stable"};
+      PlotSeries stable{name + "_limit", "speed_m_s", y, label + ": stable"};
       stable.style = "with filledcurves y1=0 fs transparent solid 0.2 noborder" + c;
       PlotSeries fold{name, "speed_m_s", y, label + ": fold"};
       fold.style = "with linespoints lw 2 pt 7 ps 0.6" + c;
@@ -117,19 +124,21 @@ class LimitMapAnalysis : public Analysis {
       const std::string table = "limit_map_" + strategy;
       Table t;
       t.columns = {"speed_m_s", "front_deg", "rear_deg", "lateral_accel_m_s2", "yaw_rate_rad_s", "side_slip_deg",
-                   "fold_test", "arclength_m_s", "stable_side", "critical_re_per_s", "critical_im_per_s",
+                   "fold_test", "arclength_m_s", "folds_at_speed", "first_fold", "stable_side", "critical_re_per_s", "critical_im_per_s",
                    "other_least_damped_re_per_s", "other_least_damped_im_per_s", "stable_front_deg",
                    "stable_lateral_accel_m_s2"};
       Json pts = Json::array();
       double ayMin = INFINITY, ayMax = -INFINITY;
-      int stableSide = 0;
+      int stableSide = 0, notFirst = 0;
       for (const auto& p : m.points) {
-        const bool st = p.stable_side == "straight_running";
-        stableSide += st;
+        const bool st = p.stable_side == "straight_running" && p.first_fold;  // shaded
+        stableSide += p.stable_side == "straight_running";
+        notFirst += !p.first_fold;
         ayMin = std::min(ayMin, std::abs(p.lateral_accel_m_s2));
         ayMax = std::max(ayMax, std::abs(p.lateral_accel_m_s2));
         t.rows.push_back({p.speed_m_s, p.front_rad / kDeg, p.rear_rad / kDeg, p.lateral_accel_m_s2, p.yaw_rate_rad_s,
-                          p.side_slip_rad / kDeg, p.fold_test, p.arclength, p.have_eigenvalues ? double(st) : NAN,
+                          p.side_slip_rad / kDeg, p.fold_test, p.arclength, double(p.folds_at_speed),
+                          double(p.first_fold), p.have_eigenvalues ? double(p.stable_side == "straight_running") : NAN,
                           p.have_eigenvalues ? p.critical.real() : NAN, p.have_eigenvalues ? p.critical.imag() : NAN,
                           p.have_eigenvalues ? p.least_damped_other.real() : NAN,
                           p.have_eigenvalues ? p.least_damped_other.imag() : NAN, st ? p.front_rad / kDeg : NAN,
@@ -137,6 +146,16 @@ class LimitMapAnalysis : public Analysis {
         pts.push_back(pointJson(p));
       }
       res.tables.push_back({table, t});
+      // The limit: the stable first folds, sorted by speed (the shading).
+      std::vector<const LimitMapPoint*> lim;
+      for (const auto& p : m.points)
+        if (p.first_fold && p.stable_side == "straight_running") lim.push_back(&p);
+      std::stable_sort(lim.begin(), lim.end(),
+                       [](const LimitMapPoint* a, const LimitMapPoint* b) { return a->speed_m_s < b->speed_m_s; });
+      Table tl;
+      tl.columns = {"speed_m_s", "front_deg", "lateral_accel_m_s2"};
+      for (const auto* p : lim) tl.rows.push_back({p->speed_m_s, p->front_rad / kDeg, p->lateral_accel_m_s2});
+      res.tables.push_back({table + "_limit", tl});
       Json hopf = Json::array(), special = Json::array();
       for (const auto& p : m.hopf_at_start) hopf.push_back(pointJson(p));
       for (const auto& p : m.curve_special) special.push_back(pointJson(p));
@@ -149,6 +168,7 @@ class LimitMapAnalysis : public Analysis {
                         {"hopf_at_start", hopf},
                         {"fold_curve_points", m.points.size()},
                         {"stable_side_points", stableSide},
+                        {"points_not_first_fold", notFirst},
                         {"speed_range_m_s", {m.points.front().speed_m_s, m.points.back().speed_m_s}},
                         {"fold_lateral_accel_range_m_s2", {ayMin, ayMax}},
                         {"curve_special_points", special},
@@ -163,7 +183,7 @@ class LimitMapAnalysis : public Analysis {
                         {"cpu_time_s", m.cpu_time_s},
                         {"points", pts}};
     }
-    res.plots.push_back(mapFigure(res));
+    res.plots.push_back(mapFigure(strategies_));
     res.summary = {{"strategies", strategies_},
                    {"maps", maps},
                    {"wall_time_s", std::chrono::duration<double>(std::chrono::steady_clock::now() - w0).count()},

@@ -178,7 +178,8 @@ Json OptimalRatioAnalysis::summarize(const OptimalRatioRun& run) const {
   if (fd.size() >= 2) {
     const RatioFit fit = fitRatio(run.speed_m_s, fd, kr);
     j["fit"] = {{"speed_m_s", fit.speed_m_s},     {"c1", fit.c1},         {"c2_per_deg2", fit.c2_per_deg2},
-                {"rms_residual", fit.rms_residual}, {"points", fit.points}, {"infeasible_points", infeasible}};
+                {"rms_residual", fit.rms_residual}, {"points", fit.points}, {"front_max_deg", fit.front_max_deg},
+                {"infeasible_points", infeasible}};
   }
   return j;
 }

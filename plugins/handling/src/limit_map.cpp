@@ -21,6 +21,9 @@ const FieldTable<LimitMapSettings>& LimitMapSettings::fields() {
           .number("front_max_rad", &S::front_max_rad, "rad", "no fold below this front angle: an error")
           .number("fold_tolerance_rad", &S::fold_tolerance_rad, "rad",
                   "bracket to which the one-parameter fold is located")
+          .number("first_fold_tolerance_rad", &S::first_fold_tolerance_rad, "rad",
+                  "a fold-curve point at a speed with several folds is the first fold from straight running when "
+                  "within this of the one-parameter fold")
           .number("g_tolerance", &S::g_tolerance, "",
                   "|bordered test function g| at a converged fold-curve point, relative to the scaled Jacobian's "
                   "second-smallest singular value at the start")
@@ -43,6 +46,7 @@ LimitMapSettings LimitMapSettings::fromParams(const ParamReader& r) {
   pos(s.front_step_rad, "front_step_rad");
   pos(s.front_max_rad, "front_max_rad");
   pos(s.fold_tolerance_rad, "fold_tolerance_rad");
+  pos(s.first_fold_tolerance_rad, "first_fold_tolerance_rad");
   pos(s.g_tolerance, "g_tolerance");
   pos(s.force_tolerance_N, "force_tolerance_N");
   pos(s.stability_tolerance_per_s, "stability_tolerance_per_s");
@@ -125,7 +129,10 @@ LimitMapResult runLimitMap(const HandlingVehicle& v, const LimitMapSettings& set
   // The arclength metric's speed scale: small against the steady state's
   // scaled change, so that a step's length is mostly speed.
   sys.mu_scale = 0.05 * set.speed_step_m_s;
+  double lastU = U0, lastDf = df0;  // the last point the curve's corrector evaluated (the error below)
   sys.residual = [&](const Eigen::VectorXd& x, double df, double U) {
+    lastU = U;
+    lastDf = df;
     setSpeed(U);
     return solver.calcDrivenEquations(x, df);
   };
@@ -192,7 +199,14 @@ LimitMapResult runLimitMap(const HandlingVehicle& v, const LimitMapSettings& set
       out.hopf_at_start.push_back(p);
     }
   curU = std::numeric_limits<double>::quiet_NaN();
-  const FoldCurveResult fc = continueFoldCurve(sys, x0, df0, U0, fo);
+  FoldCurveResult fc;
+  try {
+    fc = continueFoldCurve(sys, x0, df0, U0, fo);
+  } catch (const Error& e) {
+    throw Error("limit map (" + out.strategy + "): the fold curve could not pass speed " + formatValue(lastU) +
+                " m/s, front angle " + formatValue(lastDf * 180 / SimTK::Pi) + " deg (the last point evaluated): " +
+                e.what());
+  }
   out.bordering = fc.bordering;
   for (const auto& fp : fc.points) out.points.push_back(describe(fp.x, fp.p, fp.mu, fp.point, fp.g));
   const int n = solver.numUnknowns();
@@ -200,6 +214,30 @@ LimitMapResult runLimitMap(const HandlingVehicle& v, const LimitMapSettings& set
     LimitMapPoint p = describe(sp.point.x.head(n), sp.point.x[n], sp.point.lambda, sp.point, 0);
     p.kind = sp.kind;
     out.curve_special.push_back(p);
+  }
+  // 3. The strategy's limit: the first fold on the branch from straight
+  // running. Where the curve crosses a point's speed once, that point is it;
+  // where it crosses it several times (between folds of the curve in speed),
+  // the one-parameter continuation at that speed says which one is (within
+  // first_fold_tolerance_rad).
+  LimitMapSettings quiet = set;
+  quiet.stability = false;
+  for (auto& p : out.points) {
+    const double U = p.speed_m_s;
+    // Segments of the curve (as drawn) whose closed speed range holds U, less
+    // the interior points at U that the curve passes through monotonically
+    // (counted by both their segments); a turning point at U counts twice.
+    int crossings = 0;
+    const auto& q = out.points;
+    for (std::size_t j = 0; j + 1 < q.size(); ++j) {
+      const double a = q[j].speed_m_s, b = q[j + 1].speed_m_s;
+      crossings += std::min(a, b) <= U && U <= std::max(a, b);
+    }
+    for (std::size_t j = 1; j + 1 < q.size(); ++j)
+      crossings -= q[j].speed_m_s == U && (q[j - 1].speed_m_s - U) * (q[j + 1].speed_m_s - U) < 0;
+    p.folds_at_speed = std::max(crossings, 1);
+    if (p.folds_at_speed > 1)
+      p.first_fold = std::abs(locateFrontSteerFold(v, solver, U, quiet) - p.front_rad) <= set.first_fold_tolerance_rad;
   }
   out.stop_reason = fc.continuation.stop_reason;
   out.steps = fc.continuation.steps;

@@ -29,14 +29,9 @@ NonlinearKrStrategy::NonlinearKrStrategy(KrTable table) : table_(std::move(table
 }
 
 RearSteerTarget NonlinearKrStrategy::DoCalcTarget(double U, double df, double dfd, double dfdd) const {
-  const KrTable::Row c = table_.calcAt(U);
-  const double perDeg = 180 / SimTK::Pi;
-  const double k2 = c.c2_per_deg2 * perDeg * perDeg;  // C2 in 1/rad^2
-  const double slope = c.c1 + 3 * k2 * df * df;        // d delta_r* / d delta_f
-  return {c.c1 * df + k2 * df * df * df,               // (8.6)
-          slope * dfd,                                 // (8.7)
-          slope * dfdd + 6 * k2 * df * dfd * dfd,      // (8.8)
-          c.c1 + k2 * df * df};                        // (8.1)
+  // (8.6)-(8.8), (8.1) inside the fitted angles; the saturation beyond them (KrTable).
+  const KrTable::Rear r = table_.calcRear(U, df);
+  return {r.rear_rad, r.slope * dfd, r.slope * dfdd + r.curvature_per_rad * dfd * dfd, r.kr};
 }
 
 const std::vector<std::string>& rearSteerStrategyNames() {
@@ -61,8 +56,9 @@ void registerRearSteerStrategies(PluginRegistry& registry) {
         if (!c.table) throw Error("rear steer strategy 'nonlinear' needs a Kr coefficient table");
         return std::make_unique<NonlinearKrStrategy>(*c.table);
       },
-      typeInfo("Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1 and C2 interpolated in speed (Table 8.1); no keys of "
-               "its own: the rear_steer plugin's kr_table (required)",
+      typeInfo("Kr = C1 + C2 delta_f^2 (8.1), (8.6)-(8.8), C1 and C2 interpolated in speed (Table 8.1); beyond a "
+               "row's front_max_deg its Kr continued by a bounded C2 saturation below 1 and the two rows' laws "
+               "interpolated (KrTable); no keys of its own: the rear_steer plugin's kr_table (required)",
                noFields()));
 }
 

@@ -127,6 +127,7 @@ RatioFit fitRatio(double speed_m_s, const std::vector<double>& front_deg, const 
   for (std::size_t i = 0; i < kr.size(); ++i) ss += std::pow(kr[i] - f.evaluate(front_deg[i]), 2);
   f.rms_residual = std::sqrt(ss / n);
   f.points = int(kr.size());
+  f.front_max_deg = *distinct.rbegin();
   return f;
 }
 
@@ -142,6 +143,7 @@ std::string formatRatioTable(std::vector<RatioFit> fits) {
                     {"c2_per_deg2", fits[i].c2_per_deg2},
                     {"rms_residual", fits[i].rms_residual},
                     {"points", fits[i].points}});
+    if (std::isfinite(fits[i].front_max_deg)) rows.back()["front_max_deg"] = fits[i].front_max_deg;
   }
   return nlohmann::ordered_json{{"delta_f_unit", "deg"}, {"fit", rows}}.dump(2) + "\n";
 }
@@ -154,6 +156,15 @@ void KrTable::validate(const std::string& where) const {
     requireNonNegative(rows[i].speed_m_s, at + ".speed_m_s");
     requireFinite(rows[i].c1, at + ".c1");
     requireFinite(rows[i].c2_per_deg2, at + ".c2_per_deg2");
+    const double dm = rows[i].front_max_deg;
+    if (std::isfinite(dm) != std::isfinite(rows[0].front_max_deg))
+      throw Error(at + ".front_max_deg: must be given in every row or in none (" + where + "[0] " +
+                  (std::isfinite(rows[0].front_max_deg) ? "has it)" : "has none)"));
+    if (!(dm > 0)) throw Error(at + ".front_max_deg: must be > 0, got " + formatValue(dm));
+    if (std::isfinite(dm) && !(std::max(rows[i].c1, rows[i].evaluate(dm)) < 1))
+      throw Error(at + ": Kr = c1 + c2_per_deg2 delta_f^2 reaches " +
+                  formatValue(std::max(rows[i].c1, rows[i].evaluate(dm))) +
+                  " up to front_max_deg, must stay < 1 (the continuation beyond stays below 1)");
     if (i > 0 && !(rows[i].speed_m_s > rows[i - 1].speed_m_s))
       throw Error(at + ".speed_m_s: speeds must be ascending, got " + formatValue(rows[i].speed_m_s) + " after " +
                   formatValue(rows[i - 1].speed_m_s));
@@ -171,6 +182,7 @@ KrTable KrTable::fromParams(const ParamReader& r) {
     f.c2_per_deg2 = row.number("c2_per_deg2");
     f.rms_residual = row.numberOr("rms_residual", 0.0);
     f.points = row.has("points") ? row.integer("points") : 0;
+    if (row.has("front_max_deg")) f.front_max_deg = row.number("front_max_deg");
     t.rows.push_back(f);
   }
   r.requireAllKeysRead();
@@ -180,16 +192,93 @@ KrTable KrTable::fromParams(const ParamReader& r) {
 
 KrTable KrTable::fromFile(const std::string& path) { return fromParams(ParamReader::fromFile(path)); }
 
-KrTable::Row KrTable::calcAt(double U) const {
-  requireFinite(U, "Kr table speed_m_s");
+namespace {
+// The rows around speed U and the weight of `hi` (clamped at the table's ends: lo = hi).
+void bracket(const std::vector<KrTable::Row>& rows, double U, const KrTable::Row*& lo, const KrTable::Row*& hi,
+             double& w) {
   assert(!rows.empty());
-  if (U <= rows.front().speed_m_s) return rows.front();
-  if (U >= rows.back().speed_m_s) return rows.back();
+  w = 0;
+  if (U <= rows.front().speed_m_s) {
+    lo = hi = &rows.front();
+    return;
+  }
+  if (U >= rows.back().speed_m_s) {
+    lo = hi = &rows.back();
+    return;
+  }
   std::size_t i = 1;
   while (rows[i].speed_m_s < U) ++i;
-  const Row &lo = rows[i - 1], &hi = rows[i];
-  const double w = (U - lo.speed_m_s) / (hi.speed_m_s - lo.speed_m_s);
-  return {U, lo.c1 + w * (hi.c1 - lo.c1), lo.c2_per_deg2 + w * (hi.c2_per_deg2 - lo.c2_per_deg2)};
+  lo = &rows[i - 1];
+  hi = &rows[i];
+  w = (U - lo->speed_m_s) / (hi->speed_m_s - lo->speed_m_s);
+}
+
+// One row's law (KrTable::calcRear at that row's speed): (8.6)-(8.8) up to its
+// front_max_deg, the saturation beyond (linear_ratio.h), in rad.
+KrTable::Rear rowRear(const KrTable::Row& c, double df) {
+  const double perDeg = 180 / 3.14159265358979323846;
+  const double k2 = c.c2_per_deg2 * perDeg * perDeg;  // C2 in 1/rad^2
+  const double m = c.front_max_deg / perDeg;          // dm, rad
+  KrTable::Rear r;
+  if (!(std::abs(df) > m)) {
+    r.rear_rad = c.c1 * df + k2 * df * df * df;
+    r.slope = c.c1 + 3 * k2 * df * df;
+    r.curvature_per_rad = 6 * k2 * df;
+    r.kr = c.c1 + k2 * df * df;
+    return r;
+  }
+  const double km = c.c1 + k2 * m * m, dkm = 2 * k2 * m;  // Kr(dm), Kr'(dm)
+  double kr = km, dk = 0, ddk = 0;                       // Kr and its derivatives in |delta_f|
+  if (k2 != 0) {
+    const double g = KrTable::kSaturationFraction * (1 - km);
+    const double w = g / (std::abs(dkm) + g / (2 * m));
+    const double t = -w / (2 * m);
+    const double a = dkm * w / (1 - t * t);
+    const double th = std::tanh((std::abs(df) - m) / w + std::atanh(t));
+    const double sech2 = 1 - th * th;
+    kr = km + a * (th - t);
+    dk = a / w * sech2;
+    ddk = -2 * a / (w * w) * sech2 * th;
+  }
+  const double s = df < 0 ? -1 : 1;
+  r.kr = kr;
+  r.rear_rad = kr * df;
+  r.slope = kr + df * s * dk;  // d(Kr delta_f)/d delta_f
+  r.curvature_per_rad = 2 * s * dk + df * ddk;
+  return r;
+}
+}  // namespace
+
+KrTable::Row KrTable::calcAt(double U) const {
+  requireFinite(U, "Kr table speed_m_s");
+  const Row *lo, *hi;
+  double w;
+  bracket(rows, U, lo, hi, w);
+  if (lo == hi) return *lo;
+  Row r{U, lo->c1 + w * (hi->c1 - lo->c1), lo->c2_per_deg2 + w * (hi->c2_per_deg2 - lo->c2_per_deg2)};
+  r.front_max_deg = std::min(lo->front_max_deg, hi->front_max_deg);
+  return r;
+}
+
+KrTable::Rear KrTable::calcRear(double U, double df) const {
+  requireFinite(df, "Kr table front_rad");
+  const Row c = calcAt(U);
+  const double perDeg = 180 / 3.14159265358979323846;
+  if (!(std::abs(df) > c.front_max_deg / perDeg)) {  // inside both rows' fits: (8.6)-(8.8), (8.1)
+    const double k2 = c.c2_per_deg2 * perDeg * perDeg;  // C2 in 1/rad^2
+    Rear r;
+    r.rear_rad = c.c1 * df + k2 * df * df * df;
+    r.slope = c.c1 + 3 * k2 * df * df;
+    r.curvature_per_rad = 6 * k2 * df;
+    r.kr = c.c1 + k2 * df * df;
+    return r;
+  }
+  const Row *lo, *hi;
+  double w;
+  bracket(rows, U, lo, hi, w);
+  const Rear a = rowRear(*lo, df), b = rowRear(*hi, df);
+  return {a.rear_rad + w * (b.rear_rad - a.rear_rad), a.slope + w * (b.slope - a.slope),
+          a.curvature_per_rad + w * (b.curvature_per_rad - a.curvature_per_rad), a.kr + w * (b.kr - a.kr)};
 }
 
 std::vector<RatioFit> readRatioTable(const std::string& path) { return KrTable::fromFile(path).rows; }

@@ -19,6 +19,15 @@
 // stable just below the fold, the turn past it unstable), else "none".
 // A Hopf point met on the one-parameter branch at the start speed (a complex
 // pair crossing before the fold) is listed; its curve is not continued.
+// 3. The strategy's handling limit at a speed is the first fold on the branch
+//    from straight running as the front angle grows (step 1 at that speed).
+//    The fold curve may cross a speed several times (it turns in speed at the
+//    curve_special folds: the nonlinear 4WS strategy's curve does, twice,
+//    between 12 and 17.4 m/s); there each point is compared with step 1 at its
+//    speed and marked first_fold or not (folds_at_speed says how many times
+//    the curve crosses that speed). Elsewhere the single point is the limit.
+// If the curve's corrector cannot pass a point, Error names the strategy, the
+// speed and front angle last evaluated and the continuation's reason.
 #include <complex>
 #include <string>
 #include <vector>
@@ -36,6 +45,7 @@ struct LimitMapSettings {
   double front_step_rad = 0.005;      ///< largest step of the one-parameter continuation in delta_f, rad
   double front_max_rad = 0.5;         ///< no fold below this front angle: Error, rad
   double fold_tolerance_rad = 1e-9;   ///< bracket of the one-parameter fold's location, rad
+  double first_fold_tolerance_rad = 1e-6;  ///< |curve point - one-parameter fold| of a first fold (step 3), rad
   double g_tolerance = 1e-5;          ///< |bordered test function g| at convergence, relative to the second singular value
   int max_points = 150;               ///< fold-curve points after the start
   double force_tolerance_N = 1e-6;    ///< steady-state residual, N
@@ -58,6 +68,8 @@ struct LimitMapPoint {
   std::complex<double> least_damped_other;  ///< largest real part of the others, 1/s
   std::string stable_side;              ///< "straight_running" or "none" (see above)
   std::string kind = "regular";         ///< "start", "regular"; special points: "fold" (of the curve in speed), "hopf"
+  int folds_at_speed = 1;               ///< times the fold curve crosses this speed (step 3)
+  bool first_fold = true;               ///< the first fold from straight running at this speed: the limit (step 3)
 };
 
 struct LimitMapResult {

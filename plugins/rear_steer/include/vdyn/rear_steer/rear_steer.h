@@ -13,7 +13,13 @@
 //              delta_r* = C1 delta_f + C2 delta_f^3,                (8.6)
 //              delta_r*' = (C1 + 3 C2 delta_f^2) delta_f',          (8.7)
 //              delta_r*'' = (C1 + 3 C2 delta_f^2) delta_f'' + 6 C2 delta_f delta_f'^2   (8.8)
-//              (the scan's "5 C2" read as 6 C2, the derivative of (8.7)).
+//              (the scan's "5 C2" read as 6 C2, the derivative of (8.7));
+//              beyond a row's fitted front angles (front_max_deg) its Kr is
+//              continued by a bounded C2 saturation below 1 and the two rows'
+//              laws interpolated in speed (KrTable in linear_ratio.h); (8.6)-(8.8)
+//              become delta_r* = Kr delta_f, delta_r*' = S delta_f',
+//              delta_r*'' = S delta_f'' + S' delta_f'^2 with S = d delta_r*/d delta_f
+//              and S' its derivative (KrTable::calcRear).
 // Kr is evaluated at the current speed and its time derivative through U is
 // neglected (the seed's manoeuvres hold the speed constant).
 #include <memory>
