@@ -213,20 +213,26 @@ void bracket(const std::vector<KrTable::Row>& rows, double U, const KrTable::Row
   w = (U - lo->speed_m_s) / (hi->speed_m_s - lo->speed_m_s);
 }
 
+constexpr double kPerDeg = 180 / 3.14159265358979323846;
+
+// (8.6)-(8.8), (8.1): delta_r* = C1 delta_f + C2 delta_f^3 and its first two
+// derivatives in delta_f, Kr = C1 + C2 delta_f^2 (k2 = C2 in 1/rad^2, df in rad).
+KrTable::Rear quadraticRear(double c1, double k2, double df) {
+  KrTable::Rear r;
+  r.rear_rad = c1 * df + k2 * df * df * df;
+  r.slope = c1 + 3 * k2 * df * df;
+  r.curvature_per_rad = 6 * k2 * df;
+  r.kr = c1 + k2 * df * df;
+  return r;
+}
+
 // One row's law (KrTable::calcRear at that row's speed): (8.6)-(8.8) up to its
 // front_max_deg, the saturation beyond (linear_ratio.h), in rad.
 KrTable::Rear rowRear(const KrTable::Row& c, double df) {
-  const double perDeg = 180 / 3.14159265358979323846;
-  const double k2 = c.c2_per_deg2 * perDeg * perDeg;  // C2 in 1/rad^2
-  const double m = c.front_max_deg / perDeg;          // dm, rad
+  const double k2 = c.c2_per_deg2 * kPerDeg * kPerDeg;  // C2 in 1/rad^2
+  const double m = c.front_max_deg / kPerDeg;           // dm, rad
+  if (!(std::abs(df) > m)) return quadraticRear(c.c1, k2, df);
   KrTable::Rear r;
-  if (!(std::abs(df) > m)) {
-    r.rear_rad = c.c1 * df + k2 * df * df * df;
-    r.slope = c.c1 + 3 * k2 * df * df;
-    r.curvature_per_rad = 6 * k2 * df;
-    r.kr = c.c1 + k2 * df * df;
-    return r;
-  }
   const double km = c.c1 + k2 * m * m, dkm = 2 * k2 * m;  // Kr(dm), Kr'(dm)
   double kr = km, dk = 0, ddk = 0;                       // Kr and its derivatives in |delta_f|
   if (k2 != 0) {
@@ -263,16 +269,8 @@ KrTable::Row KrTable::calcAt(double U) const {
 KrTable::Rear KrTable::calcRear(double U, double df) const {
   requireFinite(df, "Kr table front_rad");
   const Row c = calcAt(U);
-  const double perDeg = 180 / 3.14159265358979323846;
-  if (!(std::abs(df) > c.front_max_deg / perDeg)) {  // inside both rows' fits: (8.6)-(8.8), (8.1)
-    const double k2 = c.c2_per_deg2 * perDeg * perDeg;  // C2 in 1/rad^2
-    Rear r;
-    r.rear_rad = c.c1 * df + k2 * df * df * df;
-    r.slope = c.c1 + 3 * k2 * df * df;
-    r.curvature_per_rad = 6 * k2 * df;
-    r.kr = c.c1 + k2 * df * df;
-    return r;
-  }
+  if (!(std::abs(df) > c.front_max_deg / kPerDeg))  // inside both rows' fits
+    return quadraticRear(c.c1, c.c2_per_deg2 * kPerDeg * kPerDeg, df);
   const Row *lo, *hi;
   double w;
   bracket(rows, U, lo, hi, w);
