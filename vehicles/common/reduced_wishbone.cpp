@@ -234,10 +234,20 @@ Vec3 WishboneLoop::calcUpperArmAngle(double s) const {
 ReducedKnuckleMobilizer::ReducedKnuckleMobilizer(SimTK::SimbodyMatterSubsystem& matter, const WishboneLoop& loop)
     : Implementation(matter, 2, 2, 0), loop_(loop), matter_(&matter) {}
 
-const ReducedKnuckleMobilizer::Kinematics& ReducedKnuckleMobilizer::calcKinematics(double q0, double q1) const {
-  if (q0 == memo_.q0 && q1 == memo_.q1) return memo_;
+void ReducedKnuckleMobilizer::realizeTopology(SimTK::State& s) const {
+  kinematicsIndex_ = matter_->allocateCacheEntry(s, SimTK::Stage::Model, new SimTK::Value<Kinematics>());
+}
+
+const ReducedKnuckleMobilizer::Kinematics& ReducedKnuckleMobilizer::getKinematics(const SimTK::State& s, double q0,
+                                                                                   double q1) const {
+  Kinematics& K = SimTK::Value<Kinematics>::updDowncast(matter_->updCacheEntry(s, kinematicsIndex_)).upd();
+  if (!(q0 == K.q0 && q1 == K.q1)) K = calcKinematics(q0, q1);
+  return K;
+}
+
+ReducedKnuckleMobilizer::Kinematics ReducedKnuckleMobilizer::calcKinematics(double q0, double q1) const {
   const WishboneLoop::Pose P = loop_.calcPose(q0, q1);
-  Kinematics& K = memo_;
+  Kinematics K;
   SimTK::Mat33 R, dR[2], ddR[3];
   for (int i = 0; i < 3; ++i)
     for (int j = 0; j < 3; ++j) {
@@ -268,14 +278,14 @@ const ReducedKnuckleMobilizer::Kinematics& ReducedKnuckleMobilizer::calcKinemati
 
 const ReducedKnuckleMobilizer::Kinematics& ReducedKnuckleMobilizer::atState(const SimTK::State& s) const {
   const SimTK::MobilizedBody& mb = matter_->getMobilizedBody(mbx_);
-  return calcKinematics(mb.getOneQ(s, 0), mb.getOneQ(s, 1));
+  return getKinematics(s, mb.getOneQ(s, 0), mb.getOneQ(s, 1));
 }
 
-SimTK::Transform ReducedKnuckleMobilizer::calcMobilizerTransformFromQ(const SimTK::State&, int nq,
+SimTK::Transform ReducedKnuckleMobilizer::calcMobilizerTransformFromQ(const SimTK::State& s, int nq,
                                                                      const SimTK::Real* q) const {
   assert(nq == 2);
   (void)nq;
-  return calcKinematics(q[0], q[1]).X;
+  return getKinematics(s, q[0], q[1]).X;
 }
 
 SimTK::SpatialVec ReducedKnuckleMobilizer::multiplyByHMatrix(const SimTK::State& s, int nu, const SimTK::Real* u) const {
@@ -365,21 +375,26 @@ void ArmPlanesImpl::calcPositionErrors(const SimTK::State&,
   }
 }
 
+void ArmPlanesImpl::realizeTopology(SimTK::State& s) const {
+  geoIndex_ = getMatterSubsystem().allocateCacheEntry(s, SimTK::Stage::Model, new SimTK::Value<GeoCache>());
+}
+
 const std::vector<ArmPlanesImpl::Geo>& ArmPlanesImpl::geometry(const SimTK::State& s) const {
+  GeoCache& c = SimTK::Value<GeoCache>::updDowncast(getMatterSubsystem().updCacheEntry(s, geoIndex_)).upd();
   const SimTK::Vector& q = s.getQ();
-  bool same = geoQ_.size() == q.size() && !geo_.empty();
-  for (int i = 0; same && i < q.size(); ++i) same = geoQ_[i] == q[i];
-  if (same) return geo_;
-  geo_.resize(rows_.size());
+  bool same = c.q.size() == q.size() && !c.rows.empty();
+  for (int i = 0; same && i < q.size(); ++i) same = c.q[i] == q[i];
+  if (same) return c.rows;
+  c.rows.resize(rows_.size());
   for (std::size_t i = 0; i < rows_.size(); ++i) {
     const R& r = rows_[i];
     const SimTK::Transform& X_AF = getBodyTransformFromState(s, r.F);
     const SimTK::Transform& X_AB = getBodyTransformFromState(s, r.B);
     const Vec3 p_AS = X_AF * r.p;
-    geo_[i] = {X_AB.R() * r.n.asVec3(), p_AS - X_AF.p(), p_AS - X_AB.p()};
+    c.rows[i] = {X_AB.R() * r.n.asVec3(), p_AS - X_AF.p(), p_AS - X_AB.p()};
   }
-  geoQ_ = q;
-  return geo_;
+  c.q = q;
+  return c.rows;
 }
 
 void ArmPlanesImpl::calcPositionDotErrors(const SimTK::State& s,

@@ -264,6 +264,8 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
   }
   Iso3888Run out;
   out.speed_m_s = U;
+  int steps = 0;  // integrator steps taken, counted for failed runs as well
+  const auto wall0 = std::chrono::steady_clock::now();
   try {
     BuiltScene built = desc.withOverrides(ov).build();
     const Scene& scene = built.scene();
@@ -290,8 +292,6 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     sim.integrator = set.integrator;
     struct LeftTheCourse {};
     const double xStop = L.endX() + set.lead_out_m;
-    const auto wall0 = std::chrono::steady_clock::now();
-    int steps = 0;
     try {
       out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
         if (++steps > set.max_steps)
@@ -328,6 +328,8 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
   } catch (const Error& e) {
     out.completed = false;
     out.reason = e.what();
+    out.run.steps = steps;
+    out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   }
   out.pass = out.completed && out.cones.strikes.empty();
   return out;

@@ -86,7 +86,9 @@ class WishboneLoop {
 };
 
 /// The knuckle's two-mobility custom mobilizer, q = u-integral = [s, delta].
-/// Not thread-safe: it memoizes the last pose (one Simbody system per thread).
+/// The pose and H, dH/dq at the last q are kept in a cache entry of the State
+/// (Simbody asks for X_FM, H, H^T, HDot and HDot^T at the same q many times
+/// per evaluation); the mobilizer itself holds nothing that changes.
 class ReducedKnuckleMobilizer : public SimTK::MobilizedBody::Custom::Implementation {
  public:
   ReducedKnuckleMobilizer(SimTK::SimbodyMatterSubsystem& matter, const WishboneLoop& loop);
@@ -106,14 +108,20 @@ class ReducedKnuckleMobilizer : public SimTK::MobilizedBody::Custom::Implementat
     SimTK::SpatialVec H[2];
     SimTK::SpatialVec dH[2][2];  ///< dH[j][k] = d(H column j) / d q_k
   };
-  const Kinematics& calcKinematics(double q0, double q1) const;
+  Kinematics calcKinematics(double q0, double q1) const;
+
+  /// Allocates the kinematics cache entry (Simbody calls it).
+  void realizeTopology(SimTK::State& s) const override;
 
  private:
+  /// The kinematics at (q0, q1) from the State's cache entry, computed there
+  /// when it holds another q.
+  const Kinematics& getKinematics(const SimTK::State& s, double q0, double q1) const;
   const Kinematics& atState(const SimTK::State& s) const;
   WishboneLoop loop_;
   const SimTK::SimbodyMatterSubsystem* matter_;
   SimTK::MobilizedBodyIndex mbx_;
-  mutable Kinematics memo_;
+  mutable SimTK::CacheEntryIndex kinematicsIndex_;  ///< Kinematics (Stage::Model; keyed by its q)
 };
 
 /// The arm rows of every reduced corner of a vehicle in one Constraint::Custom
@@ -156,15 +164,24 @@ class ArmPlanesImpl : public SimTK::Constraint::Custom::Implementation {
   };
   std::vector<R> rows_;
   /// Position-stage quantities of every row (n_A and the station offsets of S
-  /// from the knuckle's and the arm's origins, in A), kept for the q they were
-  /// computed at: Simbody multiplies by G and G^T once per row of G M^-1 G^T
-  /// at the same positions. Not thread-safe, as ReducedKnuckleMobilizer.
+  /// from the knuckle's and the arm's origins, in A), kept in a cache entry of
+  /// the State with the q they were computed at: Simbody multiplies by G and
+  /// G^T once per row of G M^-1 G^T at the same positions.
   struct Geo {
     SimTK::Vec3 n, rF, rB;
   };
+  struct GeoCache {
+    SimTK::Vector q;
+    std::vector<Geo> rows;
+  };
   const std::vector<Geo>& geometry(const SimTK::State& s) const;
-  mutable SimTK::Vector geoQ_;
-  mutable std::vector<Geo> geo_;
+
+ public:
+  /// Allocates the geometry cache entry (Simbody calls it).
+  void realizeTopology(SimTK::State& s) const override;
+
+ private:
+  mutable SimTK::CacheEntryIndex geoIndex_;  ///< GeoCache (Stage::Model; keyed by its q)
 };
 
 /// The two rows (lower, upper arm) of a reduced corner for ArmPlanesImpl.
