@@ -353,19 +353,59 @@ TEST(Iso3888, ClosedLoopBicyclePassesSlowAndStrikesConesFast) {
   const Iso3888Run slow = runIso3888(scene, set, L, body, 10.0);
   // Faster: the controller still brings it through the course (no spin-out,
   // the path kept), but the body overshoots the side lane and strikes cones.
-  const Iso3888Run fast = runIso3888(scene, set, L, body, 13.0);
+  const Iso3888Run fast = runIso3888(scene, set, L, body, 12.7);
+  // Faster still: it strikes cones, and later, short of grip, the controller
+  // steers past the driver's lock, where the run stops (its strikes kept).
+  const Iso3888Run faster = runIso3888(scene, set, L, body, 13.0);
   std::printf("slow: completed %d pass %d, %zu strikes, clearance %.3f m, exit %.3f m/s; fast: completed %d pass %d, "
-              "%zu strikes, clearance %.3f m %s\n",
+              "%zu strikes, clearance %.3f m %s; faster: %zu strikes, %s\n",
               slow.completed, slow.pass, slow.cones.strikes.size(), slow.cones.min_clearance_m, slow.exit_speed_m_s,
-              fast.completed, fast.pass, fast.cones.strikes.size(), fast.cones.min_clearance_m, fast.reason.c_str());
+              fast.completed, fast.pass, fast.cones.strikes.size(), fast.cones.min_clearance_m, fast.reason.c_str(),
+              faster.cones.strikes.size(), faster.reason.c_str());
   EXPECT_TRUE(slow.pass) << slow.reason;
   EXPECT_GT(slow.cones.min_clearance_m, 0.0);
   // Coasting: no drive, so the exit speed is at most the entry speed.
   EXPECT_LE(slow.exit_speed_m_s, 10.0 + 1e-9);
   EXPECT_TRUE(fast.completed) << fast.reason;
-  EXPECT_FALSE(fast.cones.strikes.empty());
-  EXPECT_LT(fast.cones.min_clearance_m, 0.0);
+  EXPECT_FALSE(fast.cones.strikes.empty());  // (a body side across a line: its corners may stay inside)
   EXPECT_FALSE(fast.pass);
+  EXPECT_LT(faster.cones.min_clearance_m, 0.0);  // a corner beyond a line before the stop
+  EXPECT_FALSE(faster.completed);
+  EXPECT_FALSE(faster.pass);
+  EXPECT_NE(faster.reason.find("steered past the lock"), std::string::npos) << faster.reason;
+  ASSERT_FALSE(faster.cones.strikes.empty());
+  EXPECT_LT(faster.cones.strikes.front().t_s, faster.t_s.back());
+  EXPECT_TRUE(std::isnan(faster.exit_speed_m_s));
+}
+
+// Past the limit the seed's controller, short of grip, winds the front wheels
+// on (toward 80 deg, where the predicted velocity of (7.13)-(7.16) turns
+// across and the slope error (7.10) has no value: the run used to end as an
+// integrator failure). The run stops at the driver's lock and says so, with
+// its steps counted; the lock is a setting.
+TEST(Iso3888, ARunPastTheLimitStopsAtTheSteeringLockAndSaysSo) {
+  PluginRegistry& reg = standardRegistry();
+  const SceneDescription scene = SceneDescription::fromFile("scenes/iso3888_bicycle.json", reg);
+  auto b = bike("gim");
+  Iso3888Settings set;
+  const BodyOutline body = b->footprint.body(set);
+  const Iso3888Layout L = Iso3888Layout::make(2 * body.half_width_m, set.entry_x_m);
+  const Iso3888Run fast = runIso3888(scene, set, L, body, 30.0);
+  std::printf("30 m/s: %s; %d steps\n", fast.reason.c_str(), fast.run.steps);
+  EXPECT_FALSE(fast.pass);
+  EXPECT_FALSE(fast.completed);
+  EXPECT_NE(fast.reason.find("steered past the lock"), std::string::npos) << fast.reason;
+  EXPECT_NE(fast.reason.find("steer_limit_rad = 0.7"), std::string::npos) << fast.reason;
+  EXPECT_GT(fast.run.steps, 100);
+  // A lower lock stops the same run earlier, at that lock.
+  Iso3888Settings low = set;
+  low.steer_limit_rad = 0.3;
+  const Iso3888Run early = runIso3888(scene, low, L, body, 30.0);
+  EXPECT_NE(early.reason.find("steer_limit_rad = 0.3"), std::string::npos) << early.reason;
+  EXPECT_LT(early.run.steps, fast.run.steps);
+  Iso3888Settings bad = set;
+  bad.steer_limit_rad = -1;
+  EXPECT_THROW(bad.validate(), Error);
 }
 
 // Sine with dwell (FMVSS 126): the metrics of a known yaw-rate history, a
@@ -761,7 +801,9 @@ TEST(Iso4138, E90ReachesItsLimitOnTheRadiusAndItsBarsReduceRoll) {
     EXPECT_NEAR(q.path_radius_m, 100.0, 1e-8) << q.speed_m_s;
     const double ay = q.speed_m_s * q.speed_m_s / 100.0;
     EXPECT_NEAR(q.lateral_accel_m_s2, ay, 1e-3 * ay) << q.speed_m_s;
-    if (q.speed_m_s < r.limit_speed_m_s - 1) EXPECT_TRUE(q.stable) << q.speed_m_s;
+    if (q.speed_m_s < r.limit_speed_m_s - 1) {
+      EXPECT_TRUE(q.stable) << q.speed_m_s;
+    }
   }
   EXPECT_GT(r.limit_lateral_accel_m_s2, 6.0);
   const ConstantRadiusResult n = run(false);

@@ -179,8 +179,13 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     try {
       status = integ->stepTo(reporting && !ownInterpolation ? std::min(nextReport(), segEnd) : segEnd);
     } catch (const std::exception& e) {
-      throw Error("simulate: " + s.integrator.method + " failed at t = " +
-                  formatValue(integ->getTime()) + " s: " + e.what());
+      // The last accepted state says where the run broke down (the integrator's
+      // message says only that it could not step on).
+      std::string what = e.what();
+      while (!what.empty() && (what.back() == '\n' || what.back() == ' ')) what.pop_back();
+      throw Error("simulate: " + s.integrator.method + " failed at t = " + formatValue(integ->getTime()) +
+                  " s; last accepted state: " + stateSummary(scene, integ->getState()) + " (last step " +
+                  formatValue(integ->getPreviousStepSizeTaken()) + " s); " + what);
     }
     using S = SimTK::Integrator;
     // A safe point: SIGINT/SIGTERM end the run here (vdyn/core/interrupt.h).

@@ -144,6 +144,7 @@ void Iso3888Settings::validate() const {
     throw Error("ISO 3888-2 speeds_per_round must be in [1, 64], got " + std::to_string(speeds_per_round));
   requirePositive(abort_path_error_m, "ISO 3888-2 abort_path_error_m");
   requirePositive(spin_limit_rad, "ISO 3888-2 spin_limit_rad");
+  requirePositive(steer_limit_rad, "ISO 3888-2 steer_limit_rad");
   requirePositive(sample_s, "ISO 3888-2 sample_s");
   if (max_steps < 1) throw Error("ISO 3888-2 max_steps must be >= 1, got " + std::to_string(max_steps));
 }
@@ -170,6 +171,8 @@ const FieldTable<Iso3888Settings>& Iso3888Settings::fields() {
                    "speeds run at once per round: 1 = bisection, k - 1 = k-section (runs on threads)")
           .number("abort_path_error_m", &S::abort_path_error_m, "m", "a run this far off the path stops and fails")
           .number("spin_limit_rad", &S::spin_limit_rad, "rad", "|side slip| beyond this: spin-out, fails")
+          .number("steer_limit_rad", &S::steer_limit_rad, "rad",
+                  "|front road-wheel angle| beyond this: past the driver's steering lock, fails")
           .number("sample_s", &S::sample_s, "s", "sampling of the motion (cone check)")
           .integer("max_steps", &S::max_steps, "", "integrator steps a run may take (beyond: stopped, fails)")
           .custom("integrator", "-", "rk_merson 1e-6", "integrator settings",
@@ -290,26 +293,50 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     sim.t_end_s = 1.3 * (L.endX() + set.lead_out_m) / U;
     sim.report_interval_s = set.sample_s;
     sim.integrator = set.integrator;
+    // The run ends when the chassis leaves the course (LeftTheCourse) or a
+    // guard stops it (Stopped: the reason); either way its samples so far
+    // are kept, and the cones it struck before a stop are reported.
     struct LeftTheCourse {};
+    struct Stopped {
+      std::string why;
+    };
     const double xStop = L.endX() + set.lead_out_m;
-    try {
-      out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
-        if (++steps > set.max_steps)
-          throw Error("more than max_steps = " + std::to_string(set.max_steps) + " integrator steps by t = " +
-                      formatValue(st.getTime()) + " s");
-        const double d = scene.evalOutput(dist, st);
-        if (!(std::abs(d) <= set.abort_path_error_m))
-          throw Error("lost the path: " + formatValue(d) + " m from it at t = " + formatValue(st.getTime()) + " s");
-        const double beta = scene.evalOutput("chassis.side_slip_rad", st);
-        if (std::abs(beta) > set.spin_limit_rad)
-          throw Error("spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
-                      formatValue(beta * 180 / SimTK::Pi) + " deg)");
-        if (scene.evalOutput("chassis.x_m", st) > xStop) throw LeftTheCourse{};
-      });
-    } catch (const LeftTheCourse&) {
+    std::string stopped;
+    auto keepCounts = [&] {
       out.run.sim_time_s = rec.time().empty() ? 0.0 : rec.time().back();
       out.run.steps = steps;
       out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    };
+    try {
+      out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
+        if (++steps > set.max_steps)
+          throw Stopped{"more than max_steps = " + std::to_string(set.max_steps) + " integrator steps by t = " +
+                        formatValue(st.getTime()) + " s"};
+        const double d = scene.evalOutput(dist, st);
+        if (!(std::abs(d) <= set.abort_path_error_m))
+          throw Stopped{"lost the path: " + formatValue(d) + " m from it at t = " + formatValue(st.getTime()) + " s"};
+        const double beta = scene.evalOutput("chassis.side_slip_rad", st);
+        if (std::abs(beta) > set.spin_limit_rad)
+          throw Stopped{"spun out at t = " + formatValue(st.getTime()) + " s (side slip " +
+                        formatValue(beta * 180 / SimTK::Pi) + " deg)"};
+        if (!frontSteer.empty()) {
+          const double delta = scene.evalOutput(frontSteer + ".angle_rad", st);
+          if (!(std::abs(delta) <= set.steer_limit_rad))
+            throw Stopped{"steered past the lock at t = " + formatValue(st.getTime()) + " s: front road-wheel angle " +
+                          formatValue(delta * 180 / SimTK::Pi) + " deg, beyond steer_limit_rad = " +
+                          formatValue(set.steer_limit_rad) + " (" +
+                          formatValue(set.steer_limit_rad * 180 / SimTK::Pi) + " deg)"};
+        }
+        if (scene.evalOutput("chassis.x_m", st) > xStop) throw LeftTheCourse{};
+      });
+    } catch (const LeftTheCourse&) {
+      keepCounts();
+    } catch (const Stopped& e) {
+      stopped = e.why;
+      keepCounts();
+    } catch (const Error& e) {  // the integrator or a plugin failed: a failed run, its samples kept
+      stopped = e.what();
+      keepCounts();
     }
     out.t_s = rec.time();
     out.x_m = rec.column("chassis.x_m");
@@ -319,13 +346,18 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     out.front_rad = frontSteer.empty() ? std::vector<double>(out.t_s.size(), 0.0) : rec.column(frontSteer + ".angle_rad");
     out.rear_rad = rearSteer.empty() ? std::vector<double>(out.t_s.size(), 0.0) : rec.column(rearSteer + ".angle_rad");
     out.cones = checkCones(L, body, out.t_s, out.x_m, out.y_m, out.yaw_rad);
-    out.exit_speed_m_s = interpolate(out.x_m, rec.column("chassis.forward_speed_m_s"), L.endX());
     out.max_path_error_m = maxAbs(out.path_error_m);
     out.peak_lateral_accel_m_s2 = maxAbs(rec.column(set.path_controller + ".lateral_acceleration_m_s2"));
     out.peak_front_steer_deg = maxAbs(out.front_rad) * 180 / SimTK::Pi;
-    out.completed = out.cones.reached_exit;
-    if (!out.completed) out.reason = "did not leave section 5 by the end of the run";
-  } catch (const Error& e) {
+    if (!stopped.empty()) {
+      out.completed = false;
+      out.reason = stopped;
+    } else {
+      out.exit_speed_m_s = interpolate(out.x_m, rec.column("chassis.forward_speed_m_s"), L.endX());
+      out.completed = out.cones.reached_exit;
+      if (!out.completed) out.reason = "did not leave section 5 by the end of the run";
+    }
+  } catch (const Error& e) {  // the scene did not build or start
     out.completed = false;
     out.reason = e.what();
     out.run.steps = steps;

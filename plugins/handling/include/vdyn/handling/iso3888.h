@@ -37,6 +37,7 @@
 // speed is whatever the scene does (coasting from the entry speed when the
 // scene has no speed hold, as the standard's released throttle; held when the
 // scene names a speed-hold plugin in `speed_hold`).
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -111,7 +112,7 @@ struct Iso3888Settings {
   /// Keys as the fields (all optional): vehicle_width_m, front_overhang_m,
   /// rear_overhang_m, entry_x_m, lead_out_m, transition_extension_m, line_clearance_m, path_controller,
   /// speed_hold, speed_low_m_s, speed_high_m_s, speed_tolerance_m_s,
-  /// speeds_per_round, abort_path_error_m, sample_s, max_steps, integrator.
+  /// speeds_per_round, abort_path_error_m, spin_limit_rad, steer_limit_rad, sample_s, max_steps, integrator.
   static Iso3888Settings fromParams(const ParamReader& r);
   /// The keys (read by fromParams, listed by `vdyn list`).
   static const FieldTable<Iso3888Settings>& fields();
@@ -136,6 +137,13 @@ struct Iso3888Settings {
   int speeds_per_round = 1;
   double abort_path_error_m = 2.0;     ///< a run this far from the path is stopped (fails)
   double spin_limit_rad = 0.5;         ///< |side slip| beyond this: spin-out (fails)
+  /// |front road-wheel angle| beyond this, rad: the driver's steering lock (a
+  /// passenger car's is about 35-40 deg at the road wheels; 0.7 rad = 40.1 deg).
+  /// A run whose path controller steers past it stops and fails there. Without
+  /// it, a controller short of grip winds the wheels on toward 80 deg, where
+  /// the predicted velocity of (7.13)-(7.16) turns across and the slope error
+  /// (7.10) has no value: the run ended as an integrator failure.
+  double steer_limit_rad = 0.7;
   double sample_s = 0.005;
   /// Integrator steps a run may take (a run on its way to a solver failure
   /// can crawl with ever smaller steps): beyond, the run stops and fails. A
@@ -156,14 +164,18 @@ struct VehicleFootprint {
 
 struct Iso3888Run {
   double speed_m_s = 0;               ///< entry speed
-  bool completed = false;             ///< false: the run failed (reason)
+  /// false: the run failed or a guard stopped it (reason); its samples up to
+  /// there are kept, `cones` holds the lines it struck before, and the figures
+  /// below describe that part only (reports print them for completed runs).
+  bool completed = false;
   std::string reason;
   ConeCheck cones;
   bool pass = false;
-  double exit_speed_m_s = 0;          ///< at section 5's end (coasting slows the vehicle)
+  double exit_speed_m_s = NAN;        ///< at section 5's end (coasting slows the vehicle); NaN if not reached
   double max_path_error_m = 0;        ///< largest |path distance| of the tracked point
   double peak_lateral_accel_m_s2 = 0; ///< of the controller's estimate
   double peak_front_steer_deg = 0;
+  /// The run's integrator counts; a failed run keeps its steps and wall time.
   RunSummary run;
   std::vector<double> t_s, x_m, y_m, yaw_rad, front_rad, rear_rad, path_error_m;  ///< samples
   void writeCsv(const std::string& path) const;
