@@ -233,6 +233,12 @@ class FirstOrderLagMeasure : public SimTK::Measure_<SimTK::Real> {
     void realizeMeasureAccelerationVirtual(const SimTK::State& s) const override {
       getSubsystem().updZDot(s)[zIndex_] = (input_(s) - getSubsystem().getZ(s)[zIndex_]) / tau_;
     }
+    /// The integrator's error weight of z (Simbody's unit weight: a change
+    /// of 1 / weight in z counts as one unit of error); the state must be
+    /// realized to Stage::Model.
+    void setErrorWeight(SimTK::State& s, double weight) const {
+      s.updZWeights(getSubsystem().getMySubsystemIndex())[zIndex_] = weight;
+    }
 
    private:
     Input input_;
@@ -242,6 +248,9 @@ class FirstOrderLagMeasure : public SimTK::Measure_<SimTK::Real> {
   FirstOrderLagMeasure(SimTK::Subsystem& sub, Input input, double tau)
       : SimTK::Measure_<SimTK::Real>(sub, new Implementation(std::move(input), tau),
                                      SimTK::AbstractMeasure::SetHandle()) {}
+  void setErrorWeight(SimTK::State& s, double weight) const {
+    static_cast<const Implementation&>(getImpl()).setErrorWeight(s, weight);
+  }
 };
 
 /// The reference model of the yaw-rate feedback: the linear bicycle ((6.5)-(6.6),
@@ -299,7 +308,7 @@ class ReferenceBicycleMeasure : public SimTK::Measure_<SimTK::Real> {
 
 /// One horizontal component (axis 0: x, 1: y) of the tracked point's
 /// acceleration in Ground through a first-order lag: a' = (x'' - a) / tau.
-SimTK::Measure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, const Vec3& station, int axis,
+FirstOrderLagMeasure addLaggedAcceleration(Scene& scene, const SimTK::MobilizedBody& chassis, const Vec3& station, int axis,
                                      double tau) {
   // The body by index, not by handle: a (reference-counted) handle held by a
   // measure of the same system kept the whole system alive (LeakSanitizer).
@@ -339,6 +348,10 @@ void PathControlPlugin::DoAddDecorations(SceneDecorations& decorations) const {
   decorations.lines.push_back(std::move(line));
 }
 
+void PathControlPlugin::DoInitialize(const Scene&, SimTK::State& state) const {
+  if (setErrorWeights_) setErrorWeights_(state);
+}
+
 void PathControlPlugin::DoAddTo(Scene& scene) {
   auto* steer = scene.findPlugin<SteeringActuator>(steering_);
   if (!steer) throw Error("path control plugin '" + name() + "': the scene has no steering plugin '" + steering_ + "'");
@@ -348,8 +361,24 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   const SimTK::MobilizedBody& chassis = scene.getBody(chassis_);
   SimTK::Measure ax, ay;
   if (p_.acceleration_estimate == "lagged") {
-    ax = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 0, p_.acceleration_lag_s);
-    ay = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 1, p_.acceleration_lag_s);
+    const FirstOrderLagMeasure lx = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 0, p_.acceleration_lag_s);
+    const FirstOrderLagMeasure ly = addLaggedAcceleration(scene, chassis, p_.tracked_point_m, 1, p_.acceleration_lag_s);
+    ax = lx;
+    ay = ly;
+    // lagged_error_weight: a enters (7.13)-(7.16) only as the predicted
+    // position's a dT^2 / 2, so an error in a counts as that much position
+    // error: weight dT^2 / 2 (m per m/s^2), one unit of weighted error being
+    // one metre of prediction, as for the chassis's own coordinates. With
+    // Simbody's default weight 1 (1 m/s^2 of a as one unit), the filter's
+    // stiff mode (-1 / tau, -333 1/s at 3 ms) held the closed-loop runs to
+    // about twice the steps at the same path errors (docs/benchmarks.md,
+    // "Closed loops").
+    const double w = 0.5 * p_.look_ahead_s * p_.look_ahead_s;
+    if (w > 0)
+      setErrorWeights_ = [lx, ly, w](SimTK::State& s) {
+        lx.setErrorWeight(s, w);
+        ly.setErrorWeight(s, w);
+      };
   }
   const SteeringActuator* rear = nullptr;
   SimTK::Measure stage1, filtered;

@@ -80,7 +80,9 @@ struct PathControlParams {
   std::string acceleration_estimate = "lagged";
   /// tau of the "lagged" estimate, s (> 0). It must stay well below the fast
   /// loop's period: on the bicycle at 10 m/s, 0.02 s already excites it (36 deg
-  /// steering peaks) and 0.05 s diverges.
+  /// steering peaks) and 0.05 s diverges. Its two z variables carry the
+  /// integrator error weight dT^2 / 2 (an error in x'' counts as the position
+  /// error it makes in (7.13)), not Simbody's 1 per m/s^2.
   double acceleration_lag_s = 0.003;
   /// The chassis point that follows the path, in the chassis frame, m (the
   /// seed: the centre of mass, [0, 0, 0]). A point at ground level keeps the
@@ -214,6 +216,9 @@ class PathControlPlugin : public ControllerPlugin {
   /// The reference path as a line on the ground (z = 0), every 0.5 m, 20 m
   /// before its start to 40 m after its end.
   void DoAddDecorations(SceneDecorations& decorations) const override;
+  /// Sets the error weights of the lagged acceleration's z variables (see
+  /// lagged_error_weight in path_control.cpp).
+  void DoInitialize(const Scene& scene, SimTK::State& state) const override;
 
  private:
   std::string steering_, chassis_;
@@ -221,6 +226,9 @@ class PathControlPlugin : public ControllerPlugin {
   PathControlParams p_;
   PathFeedforwardParams ff_;
   std::shared_ptr<const PathController> law_;
+  /// Sets the integrator's error weights of the plugin's z variables on a
+  /// state (empty: none to set).
+  std::function<void(SimTK::State&)> setErrorWeights_;
 };
 
 /// The damping of a decaying swing by the logarithmic decrement: the extremes
