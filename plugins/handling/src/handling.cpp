@@ -138,20 +138,23 @@ double solveSteeringForLateralAcceleration(const HandlingVehicle& v, double U, d
 }
 
 void HandlingHistory::writeCsv(const std::string& path) const {
+  const bool ay = !lateral_accel_m_s2.empty();
   OutputFile f(path);
-  f << "t_s,front_rad,rear_rad,yaw_rate_rad_s,lateral_accel_m_s2,x_m,y_m,yaw_rad,side_slip_rad,roll_rad\n";
+  f << "t_s,front_rad,rear_rad,yaw_rate_rad_s," << (ay ? "lateral_accel_m_s2," : "")
+    << "x_m,y_m,yaw_rad,side_slip_rad,roll_rad\n";
   f.precision(10);
-  for (std::size_t i = 0; i < t_s.size(); ++i)
-    f << t_s[i] << ',' << front_rad[i] << ',' << rear_rad[i] << ',' << yaw_rate_rad_s[i] << ','
-      << lateral_accel_m_s2[i] << ',' << x_m[i] << ',' << y_m[i] << ',' << yaw_rad[i] << ',' << side_slip_rad[i] << ','
-      << roll_rad[i] << '\n';
+  for (std::size_t i = 0; i < t_s.size(); ++i) {
+    f << t_s[i] << ',' << front_rad[i] << ',' << rear_rad[i] << ',' << yaw_rate_rad_s[i] << ',';
+    if (ay) f << lateral_accel_m_s2[i] << ',';
+    f << x_m[i] << ',' << y_m[i] << ',' << yaw_rad[i] << ',' << side_slip_rad[i] << ',' << roll_rad[i] << '\n';
+  }
   f.commit();
 }
 
 HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double t_end, double sample,
                                      const IntegratorSettings& integrator, double spinLimit, RunSummary* summary,
                                      const std::vector<double>& restarts, double coastFrom,
-                                     const SimTK::State* start) {
+                                     const SimTK::State* start, bool recordLateralAccel) {
   v.validate();
   SimTK::State s = start ? *start : v.make_initial_state(U);
   if (start) s.setTime(0);
@@ -160,9 +163,11 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
   v.scene->getSystem().realize(s, SimTK::Stage::Position);
   // The commands at t = 0 may differ from the straight start (profiles start at rest).
   v.scene->getSystem().project(s, 1e-12);
-  Recorder rec(*v.scene, {"handling.front_rad", "handling.rear_rad", "chassis.yaw_rate_rad_s",
-                          "handling.lateral_accel_m_s2", "chassis.x_m", "chassis.y_m", "chassis.yaw_rad",
-                          "chassis.side_slip_rad", "chassis.roll_rad"});
+  std::vector<std::string> cols = {"handling.front_rad", "handling.rear_rad", "chassis.yaw_rate_rad_s",
+                                   "chassis.x_m",        "chassis.y_m",       "chassis.yaw_rad",
+                                   "chassis.side_slip_rad", "chassis.roll_rad"};
+  if (recordLateralAccel) cols.push_back("handling.lateral_accel_m_s2");
+  Recorder rec(*v.scene, cols);
   SimulationSettings sim;
   sim.report_interval_s = sample;
   sim.integrator = integrator;
@@ -217,7 +222,7 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
   h.front_rad = rec.column("handling.front_rad");
   h.rear_rad = rec.column("handling.rear_rad");
   h.yaw_rate_rad_s = rec.column("chassis.yaw_rate_rad_s");
-  h.lateral_accel_m_s2 = rec.column("handling.lateral_accel_m_s2");
+  if (recordLateralAccel) h.lateral_accel_m_s2 = rec.column("handling.lateral_accel_m_s2");
   h.x_m = rec.column("chassis.x_m");
   h.y_m = rec.column("chassis.y_m");
   h.yaw_rad = rec.column("chassis.yaw_rad");

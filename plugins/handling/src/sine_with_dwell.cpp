@@ -162,8 +162,10 @@ SineWithDwellRun runSineWithDwellAmplitude(const HandlingVehicle& v, const SineW
     return SteerCommandValue{A * std::sin(w * x), A * w * std::cos(w * x), -A * w * w * std::sin(w * x)};
   });
   try {
+    // The criteria are the yaw rate's ratios and the lateral displacement: the
+    // lateral acceleration (one more evaluation per sample) is not recorded.
     run.history = runHandlingTransient(v, U, tCos + set.after_s, set.sample_s, set.integrator, 0.5, &run.run,
-                                       {t0, tCos}, set.coast ? t0 : 1e300);
+                                       {t0, tCos}, set.coast ? t0 : 1e300, nullptr, false);
     run.completed = true;
   } catch (const Error& e) {
     run.reason = e.what();

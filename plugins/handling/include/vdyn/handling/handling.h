@@ -118,9 +118,12 @@ double solveSteeringForLateralAcceleration(const HandlingVehicle& v, double spee
 
 /// Samples of a transient run of a handling test.
 struct HandlingHistory {
+  /// lateral_accel_m_s2 is empty when the run did not record it (see
+  /// runHandlingTransient's record_lateral_accel).
   std::vector<double> t_s, front_rad, rear_rad, yaw_rate_rad_s, lateral_accel_m_s2, x_m, y_m, yaw_rad, side_slip_rad,
       roll_rad;
-  /// CSV with a header row (t_s,front_rad,...).
+  /// CSV with a header row (t_s,front_rad,...); no lateral_accel_m_s2 column
+  /// when it was not recorded.
   void writeCsv(const std::string& path) const;
 };
 
@@ -133,11 +136,15 @@ struct HandlingHistory {
 /// (initialisation projects the velocities onto the new rate), since no
 /// error-controlled step passes a velocity-level step. `coast_from_s`: the
 /// speed hold is released from this time on (the vehicle coasts); infinite =
-/// held throughout.
+/// held throughout. `record_lateral_accel`: the lateral acceleration is an
+/// Acceleration-stage output, so each sample of it costs one more forward-
+/// dynamics evaluation of the interpolated state (with 2 ms samples, about as
+/// many as the integrator's own); a test that does not judge it leaves it out.
 HandlingHistory runHandlingTransient(const HandlingVehicle& v, double speed_m_s, double t_end_s, double sample_s,
                                      const IntegratorSettings& integrator, double spin_limit_rad = 0.5,
                                      RunSummary* summary = nullptr, const std::vector<double>& restarts_s = {},
-                                     double coast_from_s = 1e300, const SimTK::State* start = nullptr);
+                                     double coast_from_s = 1e300, const SimTK::State* start = nullptr,
+                                     bool record_lateral_accel = true);
 
 /// The keys every transient handling test's settings share (ISO 7401 step
 /// steer, sine with dwell): speed_m_s, lateral_accel_m_s2, sample_s and the
