@@ -343,13 +343,24 @@ TEST(Iso3888, ConeCheckFindsTheStruckLines) {
   EXPECT_EQ(turn.strikes[0].side, "left");
 }
 
-TEST(Iso3888, ClosedLoopBicyclePassesSlowAndStrikesConesFast) {
-  PluginRegistry& reg = standardRegistry();
-  const SceneDescription scene = SceneDescription::fromFile("scenes/iso3888_bicycle.json", reg);
-  auto b = bike("gim");
+namespace {
+/// The bicycle's ISO 3888-2 scene, default settings, its body and layout.
+struct BicycleCourse {
+  SceneDescription scene;
   Iso3888Settings set;
-  const BodyOutline body = b->footprint.body(set);
-  const Iso3888Layout L = Iso3888Layout::make(2 * body.half_width_m, set.entry_x_m);
+  BodyOutline body;
+  Iso3888Layout L;
+};
+BicycleCourse bicycleCourse() {
+  const SceneDescription scene = SceneDescription::fromFile("scenes/iso3888_bicycle.json", standardRegistry());
+  const Iso3888Settings set;
+  const BodyOutline body = bike("gim")->footprint.body(set);
+  return {scene, set, body, Iso3888Layout::make(2 * body.half_width_m, set.entry_x_m)};
+}
+}  // namespace
+
+TEST(Iso3888, ClosedLoopBicyclePassesSlowAndStrikesConesFast) {
+  const auto [scene, set, body, L] = bicycleCourse();
   const Iso3888Run slow = runIso3888(scene, set, L, body, 10.0);
   // Faster: the controller still brings it through the course (no spin-out,
   // the path kept), but the body overshoots the side lane and strikes cones.
@@ -384,12 +395,7 @@ TEST(Iso3888, ClosedLoopBicyclePassesSlowAndStrikesConesFast) {
 // integrator failure). The run stops at the driver's lock and says so, with
 // its steps counted; the lock is a setting.
 TEST(Iso3888, ARunPastTheLimitStopsAtTheSteeringLockAndSaysSo) {
-  PluginRegistry& reg = standardRegistry();
-  const SceneDescription scene = SceneDescription::fromFile("scenes/iso3888_bicycle.json", reg);
-  auto b = bike("gim");
-  Iso3888Settings set;
-  const BodyOutline body = b->footprint.body(set);
-  const Iso3888Layout L = Iso3888Layout::make(2 * body.half_width_m, set.entry_x_m);
+  const auto [scene, set, body, L] = bicycleCourse();
   const Iso3888Run fast = runIso3888(scene, set, L, body, 30.0);
   std::printf("30 m/s: %s; %d steps\n", fast.reason.c_str(), fast.run.steps);
   EXPECT_FALSE(fast.pass);
