@@ -369,10 +369,10 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
     // position's a dT^2 / 2, so an error in a counts as that much position
     // error: weight dT^2 / 2 (m per m/s^2), one unit of weighted error being
     // one metre of prediction, as for the chassis's own coordinates. With
-    // Simbody's default weight 1 (1 m/s^2 of a as one unit), the filter's
-    // stiff mode (-1 / tau, -333 1/s at 3 ms) held the closed-loop runs to
-    // about twice the steps at the same path errors (docs/benchmarks.md,
-    // "Closed loops").
+    // Simbody's default weight 1 (1 m/s^2 of a as one unit), the error
+    // control of a itself held the chapter 8 runs to 1.4-1.6 times the steps
+    // at the same path errors; now the lane changes reach the stability bound
+    // of the lag's mode (-1 / tau; docs/benchmarks.md, "Closed loops").
     const double w = 0.5 * p_.look_ahead_s * p_.look_ahead_s;
     if (w > 0)
       setErrorWeights_ = [lx, ly, w](SimTK::State& s) {
