@@ -10,6 +10,7 @@
 #include "test_util.h"
 #include "vdyn/handling/iso3888.h"
 #include "vdyn/handling/iso4138.h"
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/vehicles/standard_registry.h"
 #include "vdyn/handling/iso7401.h"
@@ -412,6 +413,16 @@ TEST(Iso3888, ARunPastTheLimitStopsAtTheSteeringLockAndSaysSo) {
   Iso3888Settings bad = set;
   bad.steer_limit_rad = -1;
   EXPECT_THROW(bad.validate(), Error);
+}
+
+// SIGINT during a run is not a failed run: it leaves runIso3888 (which turns
+// every other error into a failed run with its reason) as Interrupted.
+TEST(Iso3888, AnInterruptIsNotAFailedRun) {
+  const auto [scene, set, body, L] = bicycleCourse();
+  setInterruptSignal(2);
+  EXPECT_THROW(runIso3888(scene, set, L, body, 10.0), Interrupted);
+  setInterruptSignal(0);
+  EXPECT_TRUE(runIso3888(scene, set, L, body, 10.0).pass);
 }
 
 // Sine with dwell (FMVSS 126): the metrics of a known yaw-rate history, a

@@ -7,6 +7,7 @@
 
 #include "vdyn/core/animation.h"
 #include "vdyn/core/file_io.h"
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/recorder.h"
 #include "vdyn/core/sweep.h"
 #include "vdyn/handling/handling.h"
@@ -334,6 +335,8 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     } catch (const Stopped& e) {
       stopped = e.why;
       keepCounts();
+    } catch (const Interrupted&) {
+      throw;  // SIGINT/SIGTERM: the search stops, it is not a failed run
     } catch (const Error& e) {  // the integrator or a plugin failed: a failed run, its samples kept
       stopped = e.what();
       keepCounts();
@@ -357,6 +360,8 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
       out.completed = out.cones.reached_exit;
       if (!out.completed) out.reason = "did not leave section 5 by the end of the run";
     }
+  } catch (const Interrupted&) {
+    throw;
   } catch (const Error& e) {  // the scene did not build or start
     out.completed = false;
     out.reason = e.what();

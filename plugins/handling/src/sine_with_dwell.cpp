@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/sweep.h"
 
 namespace vdyn {
@@ -167,6 +168,8 @@ SineWithDwellRun runSineWithDwellAmplitude(const HandlingVehicle& v, const SineW
     run.history = runHandlingTransient(v, U, tCos + set.after_s, set.sample_s, set.integrator, 0.5, &run.run,
                                        {t0, tCos}, set.coast ? t0 : 1e300, nullptr, false);
     run.completed = true;
+  } catch (const Interrupted&) {
+    throw;  // SIGINT/SIGTERM: not a spin-out
   } catch (const Error& e) {
     run.reason = e.what();
   }
