@@ -267,6 +267,53 @@ TEST(Simulation, EachRunsCostIntegralStartsAtZero) {
   EXPECT_NEAR(first + second, total, 1e-6 * total);
 }
 
+TEST(Simulation, ARunThatThrowsLeavesItsCountsInPartial) {
+  // Whatever ends a run early (here the after-step callback at the 10th
+  // accepted step, then the max_steps guard), `partial` holds the counts up
+  // to the last accepted step: the same steps, attempts and evaluations, and
+  // the time reached, as a run that ends at that time by itself.
+  QuarterCar car(parse(quarterCarJson()));
+  SimulationSettings sim;
+  sim.t_end_s = 1.0;
+  sim.report_interval_s = 0;
+  struct Enough {};
+  SimTK::State s = car.makeInitialState();
+  RunSummary partial;
+  int n = 0;
+  double t10 = 0;
+  EXPECT_THROW(simulate(car.getScene(), s, sim, nullptr,
+                        [&](const SimTK::State& st) {
+                          if (++n == 10) t10 = st.getTime(), throw Enough{};
+                        },
+                        &partial),
+               Enough);
+  EXPECT_EQ(partial.steps, 10);
+  EXPECT_EQ(partial.integrator, "rk_merson");
+  EXPECT_DOUBLE_EQ(partial.sim_time_s, t10);
+  EXPECT_GT(partial.realizations, partial.steps);
+  EXPECT_GE(partial.attempts, partial.steps);
+  // The guard: max_steps counts attempts, checked after each accepted step
+  // (the first takes several: the start's step size is found by rejections).
+  SimTK::State g = car.makeInitialState();
+  sim.max_steps = 7;
+  RunSummary guarded;
+  EXPECT_NE(errorOf([&] { simulate(car.getScene(), g, sim, nullptr, {}, &guarded); }).find("max_steps = 7"),
+            std::string::npos);
+  EXPECT_GE(guarded.attempts, 7);
+  EXPECT_GE(guarded.steps, 1);
+  EXPECT_LT(guarded.steps, guarded.attempts);
+  EXPECT_GT(guarded.sim_time_s, 0.0);
+  // A complete run: `partial` is the summary returned.
+  SimTK::State c = car.makeInitialState();
+  sim.max_steps = SimulationSettings().max_steps;
+  sim.t_end_s = t10;
+  RunSummary whole;
+  const RunSummary ret = simulate(car.getScene(), c, sim, nullptr, {}, &whole);
+  EXPECT_EQ(whole.steps, ret.steps);
+  EXPECT_EQ(whole.realizations, ret.realizations);
+  EXPECT_DOUBLE_EQ(whole.sim_time_s, t10);
+}
+
 // --- strict keys (ParamReader::requireAllKeysRead) ---------------------------
 TEST(StrictKeys, UnknownNestedKeyIsNamedWithHint) {
   const ParamReader r = ParamReader::fromJson(Json::parse(R"({"a": {"stiffness_N_per_m": 1, "stifness_N_per_m": 2}, "b": 3})"),

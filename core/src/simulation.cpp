@@ -63,7 +63,8 @@ double positionConstraintError(const SimTK::State& state) {
 }
 
 RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& s,
-                    Recorder* recorder, const std::function<void(const SimTK::State&)>& afterStep) {
+                    Recorder* recorder, const std::function<void(const SimTK::State&)>& afterStep,
+                    RunSummary* partial) {
   if (!scene.isFinalized())
     throw Error("simulate: the scene changed after the state was made; make the state again");
   s.validate();
@@ -108,161 +109,174 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     throw Error(std::string("simulate: initializing ") + s.integrator.method + " failed: " + e.what());
   }
   sum.max_constraint_error = positionConstraintError(integ->getState());
-
-  const bool reporting = recorder && s.report_interval_s > 0;
-  if (reporting && (s.t_end_s - t0) / s.report_interval_s > double(s.max_samples))
-    throw Error("simulate: report_interval_s = " + formatValue(s.report_interval_s) + " s gives " +
-                formatValue(std::ceil((s.t_end_s - t0) / s.report_interval_s)) + " samples over " +
-                formatValue(s.t_end_s - t0) + " s, more than max_samples = " + std::to_string(s.max_samples));
-  long k = 1;  // index of the next report time t0 + k * dt (no accumulated drift)
-  auto nextReport = [&] { return std::min(s.t_end_s, t0 + k * s.report_interval_s); };
-  if (reporting) recorder->record(integ->getState());
-  double lastReported = t0;
-  // Reporting without State copies: the Runge-Kutta family (Simbody's
-  // AbstractIntegratorRep) steps to t_end and the recorder evaluates the
-  // integrator's own cubic Hermite interpolant of each step (previous Y and
-  // YDot kept here, two vectors) in one reused workspace state, unprojected
-  // (the samples read positions and velocities, no constraint needs them
-  // exact). CPodes interpolates with its own polynomial: it stops at report
-  // times and its interpolated states are not projected either.
-  const bool ownInterpolation = reporting && s.integrator.method != "cpodes";
-  if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
-  SimTK::Vector yPrev, ydotPrev;
-  double tPrev = t0;
-  int ownRealizations = 0;
-  if (ownInterpolation) {
-    const SimTK::State& s0 = integ->getState();
-    scene.getSystem().realize(s0, SimTK::Stage::Acceleration);
-    yPrev = s0.getY();
-    ydotPrev = s0.getYDot();
-  }
-  // Samples the report times in (tPrev, end of the step just taken].
-  auto sampleStep = [&](const SimTK::State& adv) {
-    const double t1 = adv.getTime();
-    if (!(t1 > tPrev)) return;
-    // The next step's first stage (the integrator then finds it done and does
-    // not count it): counted here, so `realizations` stays the number of
-    // forward-dynamics evaluations.
-    if (adv.getSystemStage() < SimTK::Stage::Acceleration) {
-      scene.getSystem().realize(adv, SimTK::Stage::Acceleration);
-      ++ownRealizations;
-    }
-    const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
-    while (lastReported < s.t_end_s - tEndTol && nextReport() <= t1 + tEndTol) {
-      const double tr = std::min(nextReport(), t1);
-      recorder->recordInterpolated(tr, tPrev, yPrev, ydotPrev, adv);
-      lastReported = tr;
-      ++k;
-    }
-    yPrev = adv.getY();
-    ydotPrev = adv.getYDot();
-    tPrev = t1;
+  int ownRealizations = 0;  // the samples' realizations (sampleStep)
+  // The counts so far, into `r` (at the end of the run, or of a run that
+  // throws: `partial`).
+  auto fillCounts = [&](RunSummary& r, double simTime) {
+    r.steps = int(doneSteps + integ->getNumStepsTaken());
+    r.attempts = int(doneAttempts + integ->getNumStepsAttempted());
+    r.realizations = int(doneRealizations + integ->getNumRealizations() + ownRealizations);
+    r.projections = int(doneProjections + integ->getNumProjections());
+    r.sim_time_s = simTime;
+    r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   };
+  try {
 
-  // Simbody 3.7's CPodes can step past the final time and then never report
-  // EndOfSimulation (simbody issue #824, fixed after 3.7), so the loop also ends
-  // when the integrator's time reaches t_end.
-  const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
-  // Run guards (SimulationSettings): each ends the run with an Error that says where.
-  int smallSteps = 0;
-  auto lastProgress = wall0;
-  auto stopped = [&](const std::string& guard) {
-    const SimTK::State& at = integ->getState();
-    return Error("simulate: " + s.integrator.method + " at accuracy " + formatValue(s.integrator.accuracy) + ": " +
-                 guard + "; stopped at " + stateSummary(scene, at) + " after " +
-                 std::to_string(integ->getNumStepsTaken()) + " steps (last step " +
-                 formatValue(integ->getPreviousStepSizeTaken()) + " s) of the run to t_end " + formatValue(s.t_end_s) +
-                 " s");
-  };
-  for (;;) {
-    SimTK::Integrator::SuccessfulStepStatus status;
-    try {
-      status = integ->stepTo(reporting && !ownInterpolation ? std::min(nextReport(), segEnd) : segEnd);
-    } catch (const std::exception& e) {
-      // The last accepted state says where the run broke down (the integrator's
-      // message says only that it could not step on).
-      std::string what = e.what();
-      while (!what.empty() && (what.back() == '\n' || what.back() == ' ')) what.pop_back();
-      throw Error("simulate: " + s.integrator.method + " failed at t = " + formatValue(integ->getTime()) +
-                  " s; last accepted state: " + stateSummary(scene, integ->getState()) + " (last step " +
-                  formatValue(integ->getPreviousStepSizeTaken()) + " s); " + what);
+    const bool reporting = recorder && s.report_interval_s > 0;
+    if (reporting && (s.t_end_s - t0) / s.report_interval_s > double(s.max_samples))
+      throw Error("simulate: report_interval_s = " + formatValue(s.report_interval_s) + " s gives " +
+                  formatValue(std::ceil((s.t_end_s - t0) / s.report_interval_s)) + " samples over " +
+                  formatValue(s.t_end_s - t0) + " s, more than max_samples = " + std::to_string(s.max_samples));
+    long k = 1;  // index of the next report time t0 + k * dt (no accumulated drift)
+    auto nextReport = [&] { return std::min(s.t_end_s, t0 + k * s.report_interval_s); };
+    if (reporting) recorder->record(integ->getState());
+    double lastReported = t0;
+    // Reporting without State copies: the Runge-Kutta family (Simbody's
+    // AbstractIntegratorRep) steps to t_end and the recorder evaluates the
+    // integrator's own cubic Hermite interpolant of each step (previous Y and
+    // YDot kept here, two vectors) in one reused workspace state, unprojected
+    // (the samples read positions and velocities, no constraint needs them
+    // exact). CPodes interpolates with its own polynomial: it stops at report
+    // times and its interpolated states are not projected either.
+    const bool ownInterpolation = reporting && s.integrator.method != "cpodes";
+    if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
+    SimTK::Vector yPrev, ydotPrev;
+    double tPrev = t0;
+    if (ownInterpolation) {
+      const SimTK::State& s0 = integ->getState();
+      scene.getSystem().realize(s0, SimTK::Stage::Acceleration);
+      yPrev = s0.getY();
+      ydotPrev = s0.getYDot();
     }
-    using S = SimTK::Integrator;
-    // A safe point: SIGINT/SIGTERM end the run here (vdyn/core/interrupt.h).
-    throwIfInterrupted("at t = " + formatValue(integ->getTime()) + " s of the run to t_end " + formatValue(s.t_end_s) +
-                       " s");
-    if (ownInterpolation) sampleStep(integ->getAdvancedState());
-    if (status == S::TimeHasAdvanced) {
-      const SimTK::State& adv = integ->getAdvancedState();
-      sum.max_constraint_error = std::max(sum.max_constraint_error, positionConstraintError(adv));
-      if (afterStep) afterStep(adv);
-      if (s.max_steps > 0 && doneAttempts + integ->getNumStepsAttempted() >= s.max_steps)
-        throw stopped("step limit max_steps = " + std::to_string(s.max_steps) + " reached");
-      const double h = integ->getPreviousStepSizeTaken();
-      smallSteps = (s.min_step_s > 0 && h < s.min_step_s && adv.getTime() < s.t_end_s - tEndTol) ? smallSteps + 1 : 0;
-      if (smallSteps >= s.min_step_count)
-        throw stopped("step size collapsed: " + std::to_string(smallSteps) + " steps in a row shorter than min_step_s = " +
-                      formatValue(s.min_step_s) + " s");
-      if (s.wall_time_budget_s > 0 || s.progress) {
-        const auto now = std::chrono::steady_clock::now();
-        const double wall = std::chrono::duration<double>(now - wall0).count();
-        if (s.wall_time_budget_s > 0 && wall > s.wall_time_budget_s)
-          throw stopped("wall-clock budget wall_time_budget_s = " + formatValue(s.wall_time_budget_s) + " s used up");
-        if (s.progress && std::chrono::duration<double>(now - lastProgress).count() >= s.progress_interval_s) {
-          lastProgress = now;
-          s.progress(adv, wall);
-        }
+    // Samples the report times in (tPrev, end of the step just taken].
+    auto sampleStep = [&](const SimTK::State& adv) {
+      const double t1 = adv.getTime();
+      if (!(t1 > tPrev)) return;
+      // The next step's first stage (the integrator then finds it done and does
+      // not count it): counted here, so `realizations` stays the number of
+      // forward-dynamics evaluations.
+      if (adv.getSystemStage() < SimTK::Stage::Acceleration) {
+        scene.getSystem().realize(adv, SimTK::Stage::Acceleration);
+        ++ownRealizations;
       }
-    } else if (status == S::ReachedReportTime) {
-      if (reporting && !ownInterpolation) {
-        recorder->record(integ->getState());
-        lastReported = integ->getTime();
+      const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
+      while (lastReported < s.t_end_s - tEndTol && nextReport() <= t1 + tEndTol) {
+        const double tr = std::min(nextReport(), t1);
+        recorder->recordInterpolated(tr, tPrev, yPrev, ydotPrev, adv);
+        lastReported = tr;
         ++k;
       }
-    }
-    const double segTol = 1e-12 * std::max(1.0, std::abs(segEnd));
-    if (seg + 1 < ends.size() && (status == S::EndOfSimulation || integ->getTime() >= segEnd - segTol)) {
-      // A restart: the next segment starts at the restart time itself (its input from the right).
-      doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
-      doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
-      SimTK::State st = integ->getState();
-      st.setTime(segEnd);
-      segEnd = ends[++seg];
-      integ->setFinalTime(segEnd);
-      try {
-        integ->initialize(st);
-      } catch (const std::exception& e) {
-        throw Error("simulate: restarting " + s.integrator.method + " at t = " + formatValue(st.getTime()) +
-                    " s (an input's rate jumps there) failed: " + e.what());
-      }
-      if (ownInterpolation) {
-        const SimTK::State& s1 = integ->getState();
-        scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
-        yPrev = s1.getY();
-        ydotPrev = s1.getYDot();
-        tPrev = s1.getTime();
-      }
-      continue;
-    }
-    if (status == S::EndOfSimulation || integ->getTime() >= s.t_end_s - tEndTol) {
-      if (reporting && integ->getTime() > lastReported + tEndTol) recorder->record(integ->getState());
-      break;
-    }
-  }
-  if (integ->isSimulationOver() &&
-      integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
-    throw Error("simulate: " + s.integrator.method + " stopped early at t = " +
-                formatValue(integ->getTime()) + " s (" +
-                SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");
+      yPrev = adv.getY();
+      ydotPrev = adv.getYDot();
+      tPrev = t1;
+    };
 
+    // Simbody 3.7's CPodes can step past the final time and then never report
+    // EndOfSimulation (simbody issue #824, fixed after 3.7), so the loop also ends
+    // when the integrator's time reaches t_end.
+    const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
+    // Run guards (SimulationSettings): each ends the run with an Error that says where.
+    int smallSteps = 0;
+    auto lastProgress = wall0;
+    auto stopped = [&](const std::string& guard) {
+      const SimTK::State& at = integ->getState();
+      return Error("simulate: " + s.integrator.method + " at accuracy " + formatValue(s.integrator.accuracy) + ": " +
+                   guard + "; stopped at " + stateSummary(scene, at) + " after " +
+                   std::to_string(integ->getNumStepsTaken()) + " steps (last step " +
+                   formatValue(integ->getPreviousStepSizeTaken()) + " s) of the run to t_end " + formatValue(s.t_end_s) +
+                   " s");
+    };
+    for (;;) {
+      SimTK::Integrator::SuccessfulStepStatus status;
+      try {
+        status = integ->stepTo(reporting && !ownInterpolation ? std::min(nextReport(), segEnd) : segEnd);
+      } catch (const std::exception& e) {
+        // The last accepted state says where the run broke down (the integrator's
+        // message says only that it could not step on).
+        std::string what = e.what();
+        while (!what.empty() && (what.back() == '\n' || what.back() == ' ')) what.pop_back();
+        throw Error("simulate: " + s.integrator.method + " failed at t = " + formatValue(integ->getTime()) +
+                    " s; last accepted state: " + stateSummary(scene, integ->getState()) + " (last step " +
+                    formatValue(integ->getPreviousStepSizeTaken()) + " s); " + what);
+      }
+      using S = SimTK::Integrator;
+      // A safe point: SIGINT/SIGTERM end the run here (vdyn/core/interrupt.h).
+      throwIfInterrupted("at t = " + formatValue(integ->getTime()) + " s of the run to t_end " + formatValue(s.t_end_s) +
+                         " s");
+      if (ownInterpolation) sampleStep(integ->getAdvancedState());
+      if (status == S::TimeHasAdvanced) {
+        const SimTK::State& adv = integ->getAdvancedState();
+        sum.max_constraint_error = std::max(sum.max_constraint_error, positionConstraintError(adv));
+        if (afterStep) afterStep(adv);
+        if (s.max_steps > 0 && doneAttempts + integ->getNumStepsAttempted() >= s.max_steps)
+          throw stopped("step limit max_steps = " + std::to_string(s.max_steps) + " reached");
+        const double h = integ->getPreviousStepSizeTaken();
+        smallSteps = (s.min_step_s > 0 && h < s.min_step_s && adv.getTime() < s.t_end_s - tEndTol) ? smallSteps + 1 : 0;
+        if (smallSteps >= s.min_step_count)
+          throw stopped("step size collapsed: " + std::to_string(smallSteps) + " steps in a row shorter than min_step_s = " +
+                        formatValue(s.min_step_s) + " s");
+        if (s.wall_time_budget_s > 0 || s.progress) {
+          const auto now = std::chrono::steady_clock::now();
+          const double wall = std::chrono::duration<double>(now - wall0).count();
+          if (s.wall_time_budget_s > 0 && wall > s.wall_time_budget_s)
+            throw stopped("wall-clock budget wall_time_budget_s = " + formatValue(s.wall_time_budget_s) + " s used up");
+          if (s.progress && std::chrono::duration<double>(now - lastProgress).count() >= s.progress_interval_s) {
+            lastProgress = now;
+            s.progress(adv, wall);
+          }
+        }
+      } else if (status == S::ReachedReportTime) {
+        if (reporting && !ownInterpolation) {
+          recorder->record(integ->getState());
+          lastReported = integ->getTime();
+          ++k;
+        }
+      }
+      const double segTol = 1e-12 * std::max(1.0, std::abs(segEnd));
+      if (seg + 1 < ends.size() && (status == S::EndOfSimulation || integ->getTime() >= segEnd - segTol)) {
+        // A restart: the next segment starts at the restart time itself (its input from the right).
+        doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
+        doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+        SimTK::State st = integ->getState();
+        st.setTime(segEnd);
+        segEnd = ends[++seg];
+        integ->setFinalTime(segEnd);
+        try {
+          integ->initialize(st);
+        } catch (const std::exception& e) {
+          throw Error("simulate: restarting " + s.integrator.method + " at t = " + formatValue(st.getTime()) +
+                      " s (an input's rate jumps there) failed: " + e.what());
+        }
+        if (ownInterpolation) {
+          const SimTK::State& s1 = integ->getState();
+          scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
+          yPrev = s1.getY();
+          ydotPrev = s1.getYDot();
+          tPrev = s1.getTime();
+        }
+        continue;
+      }
+      if (status == S::EndOfSimulation || integ->getTime() >= s.t_end_s - tEndTol) {
+        if (reporting && integ->getTime() > lastReported + tEndTol) recorder->record(integ->getState());
+        break;
+      }
+    }
+    if (integ->isSimulationOver() &&
+        integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
+      throw Error("simulate: " + s.integrator.method + " stopped early at t = " +
+                  formatValue(integ->getTime()) + " s (" +
+                  SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");
+
+  } catch (...) {
+    if (partial) {
+      *partial = sum;
+      fillCounts(*partial, integ->getTime() - t0);
+    }
+    throw;
+  }
   state = integ->getState();
-  sum.steps = int(doneSteps + integ->getNumStepsTaken());
-  sum.attempts = int(doneAttempts + integ->getNumStepsAttempted());
-  sum.realizations = int(doneRealizations + integ->getNumRealizations() + ownRealizations);
-  sum.projections = int(doneProjections + integ->getNumProjections());
-  sum.sim_time_s = s.t_end_s - t0;
-  sum.wall_time_s =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  fillCounts(sum, s.t_end_s - t0);
+  if (partial) *partial = sum;
   return sum;
 }
 

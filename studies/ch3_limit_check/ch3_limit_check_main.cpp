@@ -27,6 +27,7 @@
 #include "study.h"
 #include "vdyn/core/error.h"
 #include "vdyn/core/file_io.h"
+#include "vdyn/core/interrupt.h"
 #include "vdyn/core/named_outcome.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
@@ -149,6 +150,8 @@ int main(int argc, char** argv) {
         const Json s = runScene(transient.withOverrides(o), ro);
         out["yaw_rate_rad_s"] = s.at("final").at("chassis.yaw_rate_rad_s");
         out["events"] = s.at("events");
+      } catch (const Interrupted&) {
+        throw;  // SIGINT/SIGTERM: the sweep stops; not a transient that left its regime
       } catch (const Error& e) {
         out["left"] = e.what();
       }

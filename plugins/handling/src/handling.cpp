@@ -1,7 +1,6 @@
 #include "vdyn/handling/handling.h"
 
 #include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -178,40 +177,39 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
   if (coastFrom > 0 && coastFrom < t_end) ends.push_back(coastFrom);
   ends.push_back(t_end);
   if (coastFrom <= 0) v.speed->setEnabled(s, false);
-  RunSummary run;
-  // Counted here as well: a run that spins out (or fails) keeps its steps,
-  // simulated time and wall time in `summary` (the batteries' cost lines).
-  int stepsSoFar = 0;
-  const auto wall0 = std::chrono::steady_clock::now();
+  // A run that spins out (or fails) keeps its counts up to its last step in
+  // `summary` (the batteries' cost lines): simulate's `partial` of the segment
+  // it ended in, added to the finished segments'.
+  RunSummary run, seg;
+  auto add = [](RunSummary& to, const RunSummary& r) {
+    to.steps += r.steps, to.attempts += r.attempts, to.realizations += r.realizations;
+    to.projections += r.projections, to.wall_time_s += r.wall_time_s, to.sim_time_s += r.sim_time_s;
+    to.max_constraint_error = std::max(to.max_constraint_error, r.max_constraint_error);
+  };
   try {
     for (double te : ends) {
       if (s.getTime() >= coastFrom - 1e-12) v.speed->setEnabled(s, false);
       if (!(te > s.getTime())) continue;
       sim.t_end_s = te;
-      const RunSummary seg = simulate(*v.scene, s, sim, &rec, [&](const SimTK::State& st) {
-        ++stepsSoFar;
+      seg = RunSummary();
+      simulate(*v.scene, s, sim, &rec, [&](const SimTK::State& st) {
         const double beta = v.scene->evalOutput("chassis.side_slip_rad", st);
         if (std::abs(beta) > spinLimit)
           throw Error("'" + v.name + "' spun out at t = " + formatSig(st.getTime()) + " s (side slip " +
                       formatSig(beta * 180 / SimTK::Pi, 3) + " deg beyond " + formatSig(spinLimit * 180 / SimTK::Pi, 3) +
                       " deg)");
-      });
+      }, &seg);
       // The integrator may stop a rounding short of te; the next segment
       // starts at te itself.
       s.setTime(te);
       const RunSummary prev = run;
       run = seg;
-      run.steps += prev.steps, run.attempts += prev.attempts, run.realizations += prev.realizations;
-      run.projections += prev.projections, run.wall_time_s += prev.wall_time_s;
-      run.sim_time_s += prev.sim_time_s;
-      run.max_constraint_error = std::max(run.max_constraint_error, prev.max_constraint_error);
+      add(run, prev);
     }
   } catch (const Error&) {
     if (summary) {
-      RunSummary partial = run;
-      partial.steps = stepsSoFar;
-      partial.sim_time_s = rec.time().empty() ? 0.0 : rec.time().back();
-      partial.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+      RunSummary partial = seg;  // the segment it ended in, up to its last step
+      add(partial, run);
       *summary = partial;
     }
     throw;

@@ -268,7 +268,6 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
   }
   Iso3888Run out;
   out.speed_m_s = U;
-  int steps = 0;  // integrator steps taken, counted for failed runs as well
   const auto wall0 = std::chrono::steady_clock::now();
   try {
     BuiltScene built = desc.withOverrides(ov).build();
@@ -303,11 +302,8 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
     };
     const double xStop = L.endX() + set.lead_out_m;
     std::string stopped;
-    auto keepCounts = [&] {
-      out.run.sim_time_s = rec.time().empty() ? 0.0 : rec.time().back();
-      out.run.steps = steps;
-      out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
-    };
+    // A run that stops or fails keeps its counts up to its last step (simulate's `partial`).
+    int steps = 0;
     try {
       out.run = simulate(scene, s, sim, &rec, [&](const SimTK::State& st) {
         if (++steps > set.max_steps)
@@ -329,17 +325,14 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
                           formatValue(set.steer_limit_rad * 180 / SimTK::Pi) + " deg)"};
         }
         if (scene.evalOutput("chassis.x_m", st) > xStop) throw LeftTheCourse{};
-      });
+      }, &out.run);
     } catch (const LeftTheCourse&) {
-      keepCounts();
     } catch (const Stopped& e) {
       stopped = e.why;
-      keepCounts();
     } catch (const Interrupted&) {
       throw;  // SIGINT/SIGTERM: the search stops, it is not a failed run
     } catch (const Error& e) {  // the integrator or a plugin failed: a failed run, its samples kept
       stopped = e.what();
-      keepCounts();
     }
     out.t_s = rec.time();
     out.x_m = rec.column("chassis.x_m");
@@ -365,7 +358,6 @@ Iso3888Run runIso3888(const SceneDescription& desc, const Iso3888Settings& set, 
   } catch (const Error& e) {  // the scene did not build or start
     out.completed = false;
     out.reason = e.what();
-    out.run.steps = steps;
     out.run.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   }
   out.pass = out.completed && out.cones.strikes.empty();

@@ -76,9 +76,15 @@ double positionConstraintError(const SimTK::State& state);
 /// failures are rethrown as Error naming the time and the integrator; the run
 /// guards of `settings` (max_steps, min_step_s, wall_time_budget_s, max_samples)
 /// end a run that would not finish with an Error naming the guard, the time
-/// and a state summary (stateSummary()).
+/// and a state summary (stateSummary()). If `partial` is given and the run
+/// ends by an exception (a guard, an integration failure, Interrupted, or
+/// whatever `afterStep` throws), *partial holds the counts up to the last
+/// accepted step before it propagates: steps, attempts, realizations,
+/// projections, max_constraint_error, sim_time_s (from the start to that
+/// step) and wall_time_s; on success it is the summary returned.
 RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& settings,
                     Recorder* recorder = nullptr,
-                    const std::function<void(const SimTK::State&)>& afterStep = {});
+                    const std::function<void(const SimTK::State&)>& afterStep = {},
+                    RunSummary* partial = nullptr);
 
 }  // namespace vdyn
