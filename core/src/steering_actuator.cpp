@@ -21,6 +21,19 @@ double SteeringLaw::calcAcceleration(const SimTK::State& s) const {
   return a;
 }
 
+double SteeringLaw::DoCalcAccelerationGiven(const SimTK::State&, const SimTK::Vec3&) const {
+  throw Error("steering law '" + name_ + "' reads no station acceleration");
+}
+
+double SteeringLaw::calcAccelerationGiven(const SimTK::State& s, const SimTK::Vec3& a_G) const {
+  if (!readsStationAcceleration()) throw Error("steering law '" + name_ + "' reads no station acceleration");
+  const double a = DoCalcAccelerationGiven(s, a_G);
+  if (!std::isfinite(a))
+    throw Error("steering law '" + name_ + "': acceleration must be a finite number, got " + formatValue(a) +
+                " at t = " + formatValue(s.getTime()) + " s");
+  return a;
+}
+
 double SteeringActuator::getAngle(const SimTK::State& s) const {
   assert(isStateDriven());
   return DoGetAngle(s);

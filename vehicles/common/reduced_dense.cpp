@@ -1,5 +1,6 @@
 #include "vdyn/vehicles/reduced_dense.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "vdyn/core/error.h"
@@ -9,10 +10,12 @@ namespace vdyn {
 
 using SimTK::Vec3;
 
-void ReducedDenseRows::setRows(std::vector<Arm> arms, std::vector<Steer> steers, std::vector<Speed> speeds) {
+void ReducedDenseRows::setRows(std::vector<Arm> arms, std::vector<Steer> steers, std::vector<Speed> speeds,
+                               std::vector<Law> laws) {
   arms_ = std::move(arms);
   steers_ = std::move(steers);
   speeds_ = std::move(speeds);
+  laws_ = std::move(laws);
 }
 
 void ReducedDenseRows::realizeTopology(SimTK::State& s) const {
@@ -20,6 +23,7 @@ void ReducedDenseRows::realizeTopology(SimTK::State& s) const {
   releasedIndex_ =
       forces_->allocateDiscreteVariable(s, SimTK::Stage::Instance, new SimTK::Value<std::vector<int>>());
   lambdaIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Dynamics, new SimTK::Value<SimTK::Vector>());
+  solvedIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Dynamics, new SimTK::Value<std::vector<double>>());
   workIndex_ = forces_->allocateCacheEntry(s, SimTK::Stage::Instance, new SimTK::Value<Work>());
   structureIndex_ = forces_->allocateLazyCacheEntry(s, SimTK::Stage::Instance, new SimTK::Value<Structure>());
 }
@@ -37,6 +41,21 @@ double ReducedDenseRows::speedHoldForce(const SimTK::State& s, int k) const {
   int row = int(arms_.size() * 2 + steers_.size());
   for (int j = 0; j < k; ++j) row += isSpeedHoldEnabled(s, j) ? 1 : 0;
   return lambda[row];
+}
+
+double ReducedDenseRows::solvedSteerAcceleration(const SimTK::State& s, int k) const {
+  const Work& w = updWork(s);
+  if (w.solving) return w.x.at(k);
+  if (s.getSystemStage() < SimTK::Stage::Dynamics)
+    throw Error("steering plugin '" + laws_.at(k).plugin->name() +
+                "': its delta'' is solved by the vehicle's dense forward dynamics, known from Stage::Dynamics on "
+                "(the state is at Stage::" + s.getSystemStage().getName() + ")");
+  return SimTK::Value<std::vector<double>>::downcast(forces_->getCacheEntry(s, solvedIndex_)).get().at(k);
+}
+
+int ReducedDenseRows::lastLawSweeps(const SimTK::State& s) const {
+  const auto& v = SimTK::Value<std::vector<double>>::downcast(forces_->getCacheEntry(s, solvedIndex_)).get();
+  return v.size() > laws_.size() ? int(v.back()) : 0;
 }
 
 bool ReducedDenseRows::isSpeedHoldEnabled(const SimTK::State& s, int k) const {
@@ -137,6 +156,14 @@ void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& row
     const double bias =
         (vx * SimTK::dot(SimTK::cross(wG, ex), vG) + vy * SimTK::dot(SimTK::cross(wG, ey), vG)) / U0;
     r.b = -bias - w * r.verr;
+  }
+  for (const Law& l : laws_) {
+    // u_D' = x_D: the right side is the law's delta'', set by solveLaws.
+    RowEval& r = rows[i++];
+    const SimTK::MobilizedBody& D = l.plugin->getSteerBody();
+    r.n = 1;
+    r.u[0] = D.getFirstUIndex(s), r.g[0] = 1, r.body[0] = D.getMobilizedBodyIndex(), r.ux[0] = 0;
+    r.b = r.perr = r.verr = 0;
   }
   rows.resize(i);
 }
@@ -294,6 +321,7 @@ bool ReducedDenseRows::formBlocks(const SimTK::State& s, Work& w) const {
       for (int i = j; i < nc; ++i) S[i * 6 + j] = dot(Hc[i], X);
     }
     if (!cholesky(S, nc, 6)) return false;
+    std::copy(S, S + 36, w.S);
   }
   const Vec3 pc = C.getBodyOriginLocation(s);
   w.blocks.resize(st.children.size());
@@ -380,7 +408,8 @@ void ReducedDenseRows::realizeDynamics(const SimTK::State& s) const {
   evalRows(s, w.rows);
   const int m = int(w.rows.size());
   matter_->calcAccelerationIgnoringConstraints(s, f, F, w.udot0, w.A_GB);
-  if (!formBlocks(s, w)) formProducts(s, w);
+  w.haveS = formBlocks(s, w);
+  if (!w.haveS) formProducts(s, w);
   // r = b - G udot0.
   const double* udot0 = w.udot0.getContiguousScalarData();
   w.r.assign(m, 0.0);
@@ -393,8 +422,12 @@ void ReducedDenseRows::realizeDynamics(const SimTK::State& s) const {
   // Cholesky A = L L^T in place (lower triangle), then the two solves.
   if (!cholesky(w.A.data(), m, m))
     throw Error("reduced dense dynamics: the constraint rows are singular at t = " + formatValue(s.getTime()) + " s");
-  forwardSolve(w.A.data(), m, m, w.r.data());
-  backSolve(w.A.data(), m, m, w.r.data());
+  if (laws_.empty()) {
+    forwardSolve(w.A.data(), m, m, w.r.data());
+    backSolve(w.A.data(), m, m, w.r.data());
+  } else {
+    solveLaws(s, w);
+  }
   // f += G^T lambda.
   SimTK::Vector& lambda = SimTK::Value<SimTK::Vector>::updDowncast(forces_->updCacheEntry(s, lambdaIndex_)).upd();
   lambda.resize(m);
@@ -403,6 +436,111 @@ void ReducedDenseRows::realizeDynamics(const SimTK::State& s) const {
     const RowEval& ri = w.rows[i];
     for (int k = 0; k < ri.n; ++k) f[ri.u[k]] += ri.g[k] * w.r[i];
   }
+}
+
+void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
+  const int m = int(w.rows.size()), nL = int(laws_.size()), first = m - nL;
+  const double* L = w.A.data();
+  // lambda(x) = lam0 + sum_k x_k Lam_k.
+  w.lam0 = w.r;
+  forwardSolve(L, m, m, w.lam0.data());
+  backSolve(L, m, m, w.lam0.data());
+  w.Lam.assign(std::size_t(nL) * m, 0.0);
+  for (int k = 0; k < nL; ++k) {
+    double* e = &w.Lam[std::size_t(k) * m];
+    e[first + k] = 1;
+    forwardSolve(L, m, m, e);
+    backSolve(L, m, m, e);
+  }
+  // The station a law reads: its acceleration a(x) = a0 + sum_k x_k c_k.
+  const SteeringLaw* reader = nullptr;
+  StationAccelerationInput in;
+  for (const Law& l : laws_)
+    if (l.plugin->getAccelerationLaw()->readsStationAcceleration(&in)) {
+      if (reader)
+        throw Error("reduced dense dynamics: steering laws '" + reader->name() + "' and '" +
+                    l.plugin->getAccelerationLaw()->name() + "' both read a station's acceleration; one can");
+      reader = l.plugin->getAccelerationLaw();
+    }
+  Vec3 a0(0);
+  std::vector<Vec3> c(nL, Vec3(0));
+  if (reader) {
+    const Structure& st = getStructure(s, w.rows);
+    if (!st.chassis || st.chassis->getMobilizedBodyIndex() != in.body)
+      throw Error("reduced dense dynamics: steering law '" + reader->name() + "' reads the acceleration of body " +
+                  std::to_string(int(in.body)) + "; the dense rows give that of the chassis (a child of Ground) only");
+    const SimTK::MobilizedBody& C = *st.chassis;
+    const int nc = st.nc, u0 = C.getFirstUIndex(s);
+    // Z_i: the chassis's u' per unit lambda_i, S^-1 w_i = Ls^-T t_i (blocks)
+    // or the chassis's share of M^-1 g_i (products).
+    w.Z.assign(std::size_t(m) * 6, 0.0);
+    for (int i = 0; i < m; ++i) {
+      double* z = &w.Z[std::size_t(i) * 6];
+      if (w.haveS) {
+        for (int j = 0; j < nc; ++j) z[j] = w.t[std::size_t(i) * 6 + j];
+        backSolve(w.S, nc, 6, z);
+      } else {
+        for (int j = 0; j < nc; ++j) z[j] = w.Y[i][u0 + j];
+      }
+    }
+    // The chassis's spatial acceleration: A_GB of udot0 plus H_c du (a child
+    // of Ground: A = H u' + the velocity terms, which udot0's A_GB holds).
+    auto spatial = [&](const double* lam) {
+      double du[6] = {0, 0, 0, 0, 0, 0};
+      for (int i = 0; i < m; ++i)
+        for (int j = 0; j < nc; ++j) du[j] += lam[i] * w.Z[std::size_t(i) * 6 + j];
+      SimTK::SpatialVec A(Vec3(0), Vec3(0));
+      for (int j = 0; j < nc; ++j) A += C.getHCol(s, SimTK::MobilizerUIndex(j)) * du[j];
+      return A;
+    };
+    const Vec3 r = C.getBodyRotation(s) * in.station_B, om = C.getBodyAngularVelocity(s);
+    const SimTK::SpatialVec A0 = w.A_GB[C.getMobilizedBodyIndex()] + spatial(w.lam0.data());
+    a0 = A0[1] + SimTK::cross(A0[0], r) + SimTK::cross(om, SimTK::cross(om, r));
+    for (int k = 0; k < nL; ++k) {
+      const SimTK::SpatialVec B = spatial(&w.Lam[std::size_t(k) * m]);
+      c[k] = B[1] + SimTK::cross(B[0], r);
+    }
+  }
+  // Gauss-Seidel sweeps over the laws (the others' delta'' read through
+  // ExternalSolve: w.x while solving).
+  struct Solving {
+    Work& w;
+    ~Solving() { w.solving = false; }
+  } solving{w};
+  w.x.assign(nL, 0.0);
+  w.solving = true;
+  constexpr int kMaxSweeps = 50;
+  constexpr double kTolerance = 1e-10;  // relative to 1 + |x|, rad/s^2: above the laws' rounding (1e-12 seen)
+  int sweeps = 0;
+  double change = 0;
+  for (bool done = false; !done;) {
+    if (++sweeps > kMaxSweeps)
+      throw Error("reduced dense dynamics: the steering laws' delta'' did not settle in " + std::to_string(kMaxSweeps) +
+                  " sweeps at t = " + formatValue(s.getTime()) + " s (last relative change " + formatValue(change) + ")");
+    change = 0;
+    for (int k = 0; k < nL; ++k) {
+      const SteeringLaw* law = laws_[k].plugin->getAccelerationLaw();
+      double v;
+      if (law == reader) {
+        Vec3 a = a0;
+        for (int j = 0; j < nL; ++j) a += w.x[j] * c[j];
+        v = law->calcAccelerationGiven(s, a);
+      } else {
+        v = law->calcAcceleration(s);
+      }
+      change = std::max(change, std::abs(v - w.x[k]) / (1 + std::abs(v)));
+      w.x[k] = v;
+    }
+    done = change <= kTolerance;
+  }
+  for (int i = 0; i < m; ++i) {
+    double l = w.lam0[i];
+    for (int k = 0; k < nL; ++k) l += w.x[k] * w.Lam[std::size_t(k) * m + i];
+    w.r[i] = l;
+  }
+  std::vector<double>& out = SimTK::Value<std::vector<double>>::updDowncast(forces_->updCacheEntry(s, solvedIndex_)).upd();
+  out = w.x;
+  out.push_back(sweeps);
 }
 
 }  // namespace vdyn

@@ -357,7 +357,8 @@ double WheeledVehicle::totalMass() const {
 int WheeledVehicle::degreesOfFreedom(const SimTK::State& s) const {
   scene_->getSystem().realize(s, SimTK::Stage::Instance);
   // A state-driven steering plugin's steer body moves by a prescribed acceleration.
-  const int denseRows = dense_ && dense_->isActive(s) ? dense_->numRows() : 0;  // rows Simbody does not see
+  // (In a dense state the steering laws' rows stand for those Motions.)
+  const int denseRows = dense_ && dense_->isActive(s) ? dense_->numConstraintRows() : 0;  // rows Simbody does not see
   return s.getNU() - s.getNUDotErr() - denseRows - static_cast<int>(steeringStateBodies(*scene_).size());
 }
 
@@ -609,6 +610,19 @@ void WheeledVehicle::useDenseRows(SimTK::State& s) const {
                           "speed holds on the chassis; use formulation \"reduced\" or \"constrained\")";
   if (!collectDenseRows(&arms, &steers, &holds, &whyNot)) throw Error("vehicle: dense forward dynamics: " + whyNot + why);
   const Scene& sc = *scene_;
+  // Every state-driven steering's delta'' is a row of the dense system (its
+  // Motion disabled below), solved with its law (reduced_dense.h).
+  std::vector<ReducedDenseRows::Law> laws;
+  std::vector<const SteeringPlugin*> lawPlugins;
+  for (const auto& plugin : sc.getPlugins())
+    if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get()); st && st->isStateDriven()) {
+      const ReducedDenseRows* dense = dense_;
+      const int k = int(laws.size());
+      st->setExternalSolve({[dense](const SimTK::State& x) { return dense->isActive(x); },
+                            [dense, k](const SimTK::State& x) { return dense->solvedSteerAcceleration(x, k); }});
+      laws.push_back({st});
+      lawPlugins.push_back(st);
+    }
   std::vector<ReducedDenseRows::Speed> speeds;
   for (const SpeedHoldPlugin* sp : holds) {
     const ReducedDenseRows* dense = dense_;
@@ -618,15 +632,16 @@ void WheeledVehicle::useDenseRows(SimTK::State& s) const {
                         [dense, k](SimTK::State& st, bool on) { dense->setSpeedHoldEnabled(st, k, on); }});
     speeds.push_back({chassis_, sp});
   }
-  dense_->setRows(std::move(arms), std::move(steers), std::move(speeds));
+  dense_->setRows(std::move(arms), std::move(steers), std::move(speeds), std::move(laws));
   const SimTK::MultibodySystem& system = sc.getSystem();
   if (dense_->isActive(s)) return;
   system.realize(s, SimTK::Stage::Instance);
-  if (s.getNUDotErr() != dense_->numRows())
+  if (s.getNUDotErr() != dense_->numConstraintRows())
     throw Error("vehicle: the scene has " + std::to_string(s.getNUDotErr()) + " constraint rows, the dense path solves " +
-                std::to_string(dense_->numRows()) + why);
+                std::to_string(dense_->numConstraintRows()) + why);
   const SimTK::SimbodyMatterSubsystem& m = sc.getMatter();
   for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).disable(s);
+  for (const SteeringPlugin* st : lawPlugins) st->getSteerBody().getMotion().disable(s);
   dense_->setActive(s, true);
 }
 
@@ -642,6 +657,9 @@ void useSimbodyRowsOf(const Scene& scene, const ReducedDenseRows* dense, SimTK::
   dense->setActive(s, false);
   const SimTK::SimbodyMatterSubsystem& m = scene.getMatter();
   for (SimTK::ConstraintIndex cx(0); cx < m.getNumConstraints(); ++cx) m.getConstraint(cx).enable(s);
+  for (const auto& plugin : scene.getPlugins())
+    if (const auto* st = dynamic_cast<const SteeringPlugin*>(plugin.get()); st && st->isStateDriven() && !st->drivesRack())
+      st->getSteerBody().getMotion().enable(s);
   k = 0;
   for (const auto& plugin : scene.getPlugins())
     if (const auto* sp = dynamic_cast<const SpeedHoldPlugin*>(plugin.get()))

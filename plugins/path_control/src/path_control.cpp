@@ -21,8 +21,8 @@ void PathControlParams::validate() const {
   requireNonNegative(look_ahead_s, "path control look_ahead_s");
   requirePositive(acceleration_lag_s, "path control acceleration_lag_s");
   for (int i = 0; i < 3; ++i) requireFinite(tracked_point_m[i], "path control tracked_point_m");
-  if (acceleration_estimate != "lagged" && acceleration_estimate != "none")
-    throw Error("path control acceleration_estimate must be \"lagged\" or \"none\", got \"" +
+  if (acceleration_estimate != "solved" && acceleration_estimate != "lagged" && acceleration_estimate != "none")
+    throw Error("path control acceleration_estimate must be \"solved\", \"lagged\" or \"none\", got \"" +
                 acceleration_estimate + "\"");
 }
 
@@ -125,7 +125,7 @@ const FieldTable<PathControlParams>& gainFields() {
           .number("k4_rad_per_s2", &P::k4_rad_per_s2, "rad/s^2", "K4 on e4, slope error at t + dT", true)
           .number("k5_per_s", &P::k5_per_s, "1/s", "K5, damper on delta' (7.18)", true)
           .number("look_ahead_s", &P::look_ahead_s, "s", "dT of the prediction (7.13)-(7.16)", true)
-          .string("acceleration_estimate", &P::acceleration_estimate, "x'' in the prediction: lagged | none")
+          .string("acceleration_estimate", &P::acceleration_estimate, "x'' in the prediction: solved (with delta'', dense formulation) | lagged | none")
           .number("acceleration_lag_s", &P::acceleration_lag_s, "s", "lag of the measured acceleration (lagged)")
           .vec3("tracked_point_m", &P::tracked_point_m, "m", "chassis point that follows the path, chassis frame");
   return t;
@@ -154,15 +154,33 @@ PathController::PathController(std::string name, const PathControlParams& params
   if (!path_) throw Error("path controller '" + this->name() + "': no path");
   assert(p_.acceleration_estimate != "lagged" || (!ax_.isEmptyHandle() && !ay_.isEmptyHandle()));
   lagged_ = p_.acceleration_estimate == "lagged";
+  solved_ = p_.acceleration_estimate == "solved";
+}
+
+bool PathController::DoGetStationAccelerationInput(StationAccelerationInput* input) const {
+  if (!solved_) return false;
+  if (input) *input = {chassis_.getMobilizedBodyIndex(), p_.tracked_point_m};
+  return true;
 }
 
 PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) const {
+  if (!solved_) return calcEvaluationGiven(s, lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0));
+  if (s.getSystemStage() < SimTK::Stage::Acceleration)
+    throw Error("path controller '" + name() + "': acceleration_estimate \"solved\" needs x'' and delta'' solved "
+                "together, which the vehicle's dense forward dynamics does (formulation \"auto\" or \"dense\"); "
+                "here delta'' was asked before the accelerations (t = " + formatValue(s.getTime()) +
+                " s): use acceleration_estimate \"lagged\" with this formulation");
+  const Vec3 a = chassis_.findStationAccelerationInGround(s, p_.tracked_point_m);
+  return calcEvaluationGiven(s, Vec2(a[0], a[1]));
+}
+
+PathControlEvaluation PathController::calcEvaluationGiven(const SimTK::State& s, const Vec2& xdd_G) const {
   PathControlEvaluation e;
   const Vec3 p = chassis_.findStationLocationInGround(s, p_.tracked_point_m),
              v = chassis_.findStationVelocityInGround(s, p_.tracked_point_m);
   e.p_G = Vec2(p[0], p[1]);
   e.v_G = Vec2(v[0], v[1]);
-  e.a_G = lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0);
+  e.a_G = xdd_G;
   const double rear = ff_.enabled() && rear_ ? rear_->getAngle(s) : 0.0;
   if (ff_.enabled()) {
     // The prediction (7.13)-(7.16) takes the turn the feed-forward is about to
@@ -436,19 +454,27 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
                                           ratio, yawRef);
   steer->setAccelerationLaw(law_);
   const auto law = law_;
-  auto add = [&](const std::string& key, const std::string& unit, auto f) {
-    scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity,
-                     [law, f](const SimTK::State& s) { return f(law->calcEvaluation(s)); }});
+  // Outputs of what x'' moves (e3, e4, x'' itself) need Stage::Acceleration
+  // with the "solved" estimate; the others are read with x'' = 0 there.
+  const bool solved = p_.acceleration_estimate == "solved";
+  auto add = [&](const std::string& key, const std::string& unit, bool readsXdd, auto f) {
+    if (solved && !readsXdd)
+      scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity,
+                       [law, f](const SimTK::State& s) { return f(law->calcEvaluationGiven(s, Vec2(0, 0))); }});
+    else
+      scene.addOutput({name() + "." + key, unit, solved ? SimTK::Stage::Acceleration : SimTK::Stage::Velocity,
+                       [law, f](const SimTK::State& s) { return f(law->calcEvaluation(s)); }});
   };
-  add("e1_m", "m", [](const PathControlEvaluation& e) { return e.now.position_m; });
-  add("e2", "1", [](const PathControlEvaluation& e) { return e.now.slope; });
-  add("e3_m", "m", [](const PathControlEvaluation& e) { return e.ahead.position_m; });
-  add("e4", "1", [](const PathControlEvaluation& e) { return e.ahead.slope; });
-  add("feedforward_rad", "rad", [](const PathControlEvaluation& e) { return e.feedforward_rad; });
-  add("feedforward_target_rad", "rad", [](const PathControlEvaluation& e) { return e.feedforward_target_rad; });
-  add("reference_yaw_rate_rad_s", "rad/s", [](const PathControlEvaluation& e) { return e.reference_yaw_rate_rad_s; });
-  // The estimated acceleration's component normal to the velocity (+ left).
-  add("lateral_acceleration_m_s2", "m/s^2", [](const PathControlEvaluation& e) {
+  add("e1_m", "m", false, [](const PathControlEvaluation& e) { return e.now.position_m; });
+  add("e2", "1", false, [](const PathControlEvaluation& e) { return e.now.slope; });
+  add("e3_m", "m", true, [](const PathControlEvaluation& e) { return e.ahead.position_m; });
+  add("e4", "1", true, [](const PathControlEvaluation& e) { return e.ahead.slope; });
+  add("feedforward_rad", "rad", false, [](const PathControlEvaluation& e) { return e.feedforward_rad; });
+  add("feedforward_target_rad", "rad", false, [](const PathControlEvaluation& e) { return e.feedforward_target_rad; });
+  add("reference_yaw_rate_rad_s", "rad/s", false,
+      [](const PathControlEvaluation& e) { return e.reference_yaw_rate_rad_s; });
+  // The estimated (or solved) acceleration's component normal to the velocity (+ left).
+  add("lateral_acceleration_m_s2", "m/s^2", true, [](const PathControlEvaluation& e) {
     const double v = e.v_G.norm();
     return v > 0 ? (e.v_G[0] * e.a_G[1] - e.v_G[1] * e.a_G[0]) / v : 0.0;
   });

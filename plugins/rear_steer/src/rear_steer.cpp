@@ -114,14 +114,15 @@ RearSteerLaw::RearSteerLaw(std::string name, std::shared_ptr<const RearSteerStra
   if (!strategy_) throw Error("rear steer law '" + this->name() + "': no strategy");
 }
 
-RearSteerEvaluation RearSteerLaw::calcEvaluation(const SimTK::State& s) const {
+RearSteerEvaluation RearSteerLaw::calcEvaluation(const SimTK::State& s, bool withFrontAcceleration) const {
   RearSteerEvaluation e;
   const Vec3 v = chassis_.getBodyOriginVelocity(s);
   e.speed_m_s = std::sqrt(v[0] * v[0] + v[1] * v[1]);
   e.front_angle_rad = front_->getAngle(s);
   e.front_rate_rad_s = front_->getRate(s);
-  e.front_accel_rad_s2 = front_->calcAcceleration(s);
+  e.front_accel_rad_s2 = withFrontAcceleration ? front_->calcAcceleration(s) : 0.0;
   e.target = strategy_->calcTarget(e.speed_m_s, e.front_angle_rad, e.front_rate_rad_s, e.front_accel_rad_s2);
+  if (!withFrontAcceleration) e.front_accel_rad_s2 = e.target.accel_rad_s2 = SimTK::NaN;
   e.rear_angle_rad = rear_->getAngle(s);
   e.rear_rate_rad_s = rear_->getRate(s);
   // (8.5) / (8.8): the target's acceleration plus the G1, G2 tracking terms.
@@ -163,11 +164,11 @@ void RearSteerPlugin::DoAddTo(Scene& scene) {
   rear->setAccelerationLaw(law_);
   const auto law = law_;
   scene.addOutput({name() + ".kr", "1", SimTK::Stage::Velocity,
-                   [law](const SimTK::State& s) { return law->calcEvaluation(s).target.kr; }});
+                   [law](const SimTK::State& s) { return law->calcEvaluation(s, false).target.kr; }});
   scene.addOutput({name() + ".target_rad", "rad", SimTK::Stage::Velocity,
-                   [law](const SimTK::State& s) { return law->calcEvaluation(s).target.angle_rad; }});
+                   [law](const SimTK::State& s) { return law->calcEvaluation(s, false).target.angle_rad; }});
   scene.addOutput({name() + ".tracking_error_rad", "rad", SimTK::Stage::Velocity, [law](const SimTK::State& s) {
-                     const RearSteerEvaluation e = law->calcEvaluation(s);
+                     const RearSteerEvaluation e = law->calcEvaluation(s, false);
                      return e.rear_angle_rad - e.target.angle_rad;
                    }});
 }

@@ -448,9 +448,13 @@ SimTK::MobilizedBodyIndex SteeringPlugin::stateBodyIndex() const {
   return drivesRack() ? rackBody_.getMobilizedBodyIndex() : steer_.getMobilizedBodyIndex();
 }
 
-double SteeringPlugin::DoCalcAcceleration(const SimTK::State& s) const {
-  return slot_->law->calcAcceleration(s);
+double SteeringPlugin::LawSlot::calcAcceleration(const SimTK::State& s, const std::string& who) const {
+  if (external.solved && external.solved(s)) return external.acceleration(s);
+  if (!law) throw Error("steering plugin '" + who + "': no acceleration law");
+  return law->calcAcceleration(s);
 }
+
+double SteeringPlugin::DoCalcAcceleration(const SimTK::State& s) const { return slot_->calcAcceleration(s, name()); }
 
 const SimTK::MobilizedBody::Pin& SteeringPlugin::getSteerBody() const {
   assert(stateDriven_);
@@ -477,8 +481,8 @@ void SteeringPlugin::addStateDriven(Scene& scene) {
   const std::weak_ptr<LawSlot> weakSlot = slot_;
   SimTK::Motion::Custom(steer_, new SteeringLawMotion([weakSlot, who](const SimTK::State& s) {
     const auto slot = weakSlot.lock();
-    if (!slot || !slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
-    return slot->law->calcAcceleration(s);
+    if (!slot) throw Error("steering plugin '" + who + "': no acceleration law");
+    return slot->calcAcceleration(s, who);
   }));
   scene.addBody(name() + ".steer", steer_);
   for (const auto& k : knuckles_)
@@ -492,10 +496,11 @@ void SteeringPlugin::addStateDriven(Scene& scene) {
                    [steer](const SimTK::State& s) { return steer.getAngle(s); }});
   scene.addOutput({name() + ".rate_rad_s", "rad/s", SimTK::Stage::Velocity,
                    [steer](const SimTK::State& s) { return steer.getRate(s); }});
-  scene.addOutput({name() + ".accel_rad_s2", "rad/s^2", SimTK::Stage::Velocity, [slot, who](const SimTK::State& s) {
-                     if (!slot->law) throw Error("steering plugin '" + who + "': no acceleration law");
-                     return slot->law->calcAcceleration(s);
-                   }});
+  // Stage::Dynamics: where the vehicle's dense rows solve delta'' it is known
+  // once forces are (ExternalSolve); a law that reads a station's
+  // acceleration needs Stage::Acceleration elsewhere (it says so).
+  scene.addOutput({name() + ".accel_rad_s2", "rad/s^2", SimTK::Stage::Dynamics,
+                   [slot, who](const SimTK::State& s) { return slot->calcAcceleration(s, who); }});
   scene.addOutput({name() + ".angle_rad", "rad", SimTK::Stage::Position,
                    [ch, first, axis](const SimTK::State& s) { return steeringAngle(s, ch, first, axis); }});
   // The wheel's angle against its integrated state: what an acceleration-only

@@ -32,7 +32,7 @@
 /// Recorder's constructor (AnalysisContext::animation), SceneDecorations'
 /// cone size. A library must return the value it was compiled with from
 /// vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 7
+#define VDYN_PLUGIN_ABI_VERSION 8
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))

@@ -16,21 +16,50 @@
 
 namespace vdyn {
 
+/// The Ground acceleration of a station of a body, as a law's input (the path
+/// controller's x'' of (7.13)-(7.16)).
+struct StationAccelerationInput {
+  SimTK::MobilizedBodyIndex body;  ///< the body the station is fixed in
+  SimTK::Vec3 station_B{0};        ///< the station in the body frame, m
+};
+
 /// A steering acceleration law: delta'' (rad/s^2, + toward left) as a function
 /// of the state, e.g. a path controller. It may depend on positions, velocities
-/// and z variables (Stage::Velocity and the Time-stage z's), never on
-/// accelerations.
+/// and z variables (Stage::Velocity and the Time-stage z's) and on the
+/// accelerations of other steerings (SteeringActuator::calcAcceleration).
+///
+/// A law may also read the Ground acceleration of one station
+/// (readsStationAcceleration()), which itself depends on delta'': then the
+/// two are solved together in one evaluation, by the vehicle's dense forward
+/// dynamics (vdyn/vehicles/reduced_dense.h), which calls
+/// calcAccelerationGiven() with each iterate of the station's acceleration;
+/// calcAcceleration() of such a law needs a state realized to
+/// Stage::Acceleration (it reads the realized acceleration, the solved one in
+/// a dense state) and throws below it.
 class SteeringLaw {
  public:
   virtual ~SteeringLaw();
-  /// delta'' on a state realized to Stage::Velocity; throws Error naming the
-  /// law and the time if it is not a finite number.
+  /// delta'' on a state realized to Stage::Velocity (Stage::Acceleration for a
+  /// law that reads a station's acceleration); throws Error naming the law and
+  /// the time if it is not a finite number.
   double calcAcceleration(const SimTK::State& s) const;
+  /// True when delta'' depends on the Ground acceleration of a station; then
+  /// `input` (if given) says which.
+  bool readsStationAcceleration(StationAccelerationInput* input = nullptr) const {
+    return DoGetStationAccelerationInput(input);
+  }
+  /// delta'' of a law that reads a station's acceleration, given that
+  /// acceleration a_G (m/s^2, in Ground), on a state realized to
+  /// Stage::Velocity; throws Error naming the law if it reads none, or if the
+  /// result is not finite.
+  double calcAccelerationGiven(const SimTK::State& s, const SimTK::Vec3& a_G) const;
   const std::string& name() const { return name_; }
 
  protected:
   explicit SteeringLaw(std::string name) : name_(std::move(name)) {}
   virtual double DoCalcAcceleration(const SimTK::State& s) const = 0;
+  virtual bool DoGetStationAccelerationInput(StationAccelerationInput*) const { return false; }
+  virtual double DoCalcAccelerationGiven(const SimTK::State& s, const SimTK::Vec3& a_G) const;
 
  private:
   std::string name_;
@@ -52,7 +81,10 @@ class SteeringActuator {
   double getAngle(const SimTK::State& s) const;
   /// State-driven only: delta' (rad/s; Stage::Velocity).
   double getRate(const SimTK::State& s) const;
-  /// State-driven with a law only: delta'' (rad/s^2) from the law (Stage::Velocity).
+  /// State-driven with a law only: delta'' (rad/s^2): the law's on a state
+  /// realized to Stage::Velocity, or, where the vehicle's dense forward dynamics
+  /// solves the steering's delta'' (a dense state), the solved value
+  /// (Stage::Dynamics).
   double calcAcceleration(const SimTK::State& s) const;
 
  protected:

@@ -17,6 +17,9 @@
 //               SteeringStateConstraintImpl row x_B . (s_F - y_D) = 0 written
 //               on the reduced coordinates, -sin(delta) = -sin(q_D))
 //   speed hold  (v_xi^2 + v_eta^2 - U0^2) / (2 U0) = 0 (SpeedHoldImpl's row)
+//   steering law  u_D' = x_D per state-driven steering (Law): the steer
+//               body's Motion is disabled in a dense state and its delta''
+//               is this row's right side, solved with the rest (below)
 // They are the same constraints as the Simbody rows (a point in the arm's
 // plane through its pivot axis holds exactly when the arm's angle is the
 // loop's), so the equations of motion are the same. Per evaluation, with the
@@ -37,6 +40,20 @@
 // so its column of G enters G udot0 only and
 // its share of G^T lambda is carried by the Motion's reaction, as the
 // Simbody row's is.
+//
+// The steering laws. A law's delta'' may read the chassis's acceleration
+// (the path controller's x'' of (7.13), SteeringLaw::readsStationAcceleration)
+// or another steering's delta'' (the rear-steer law reads the front's), and
+// the accelerations depend on every delta'' in turn: one algebraic loop,
+// solved in each evaluation. The system is linear in the right sides x of the
+// law rows, lambda(x) = A^-1 (r0 + E x), so the chassis's acceleration is
+// affine in x, a(x) = a0 + C x (from the chassis's share of M^-1 G^T, the
+// blocks' S^-1 w_i); each law is evaluated at the current x (the others'
+// delta'' read through SteeringPlugin::ExternalSolve, the station's
+// acceleration given), sweep after sweep (Gauss-Seidel) until no x changes by
+// more than 1e-10 (1 + |x|) rad/s^2; the coupling is the steering's own
+// inertia, small, so two or three sweeps. delta'' and x'' then satisfy the law
+// and the equations of motion together, with no lag state.
 //
 // Simbody does not know these rows, so it does not project onto them; their
 // drift is held by Baumgarte terms (b - 2 w verr - w^2 perr for the holonomic
@@ -86,8 +103,21 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
     SimTK::MobilizedBody::Free chassis;
     const SpeedHoldPlugin* plugin = nullptr;
   };
-  void setRows(std::vector<Arm> arms, std::vector<Steer> steers, std::vector<Speed> speeds);
-  int numRows() const { return int(arms_.size() * 2 + steers_.size() + speeds_.size()); }
+  /// A state-driven steering whose delta'' the rows solve (its steer body's
+  /// Motion disabled in a dense state).
+  struct Law {
+    const SteeringPlugin* plugin = nullptr;
+  };
+  void setRows(std::vector<Arm> arms, std::vector<Steer> steers, std::vector<Speed> speeds, std::vector<Law> laws);
+  /// Every row, the steering laws' included.
+  int numRows() const { return int(arms_.size() * 2 + steers_.size() + speeds_.size() + laws_.size()); }
+  /// The rows that stand for Simbody constraints (all but the laws').
+  int numConstraintRows() const { return int(arms_.size() * 2 + steers_.size() + speeds_.size()); }
+  /// The k-th law's delta'' (rad/s^2) in a dense state realized to
+  /// Stage::Dynamics (during the solve: its current value).
+  double solvedSteerAcceleration(const SimTK::State& s, int k) const;
+  /// Sweeps of the last solve of the laws in `s` (Stage::Dynamics; tests).
+  int lastLawSweeps(const SimTK::State& s) const;
 
   bool isActive(const SimTK::State& s) const;
   void setActive(SimTK::State& s, bool active) const;
@@ -169,7 +199,14 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
     SimTK::Vector_<SimTK::SpatialVec> A_GB;
     std::vector<double> A, r, t;
     std::vector<ChildBlocks> blocks;
+    double S[36];  ///< the chassis's articulated inertia's factor (formBlocks)
+    bool haveS = false;
+    // The laws' solve: x their delta'', solving while it runs.
+    std::vector<double> x, lam0, Lam, Z;
+    bool solving = false;
   };
+  /// The laws' solve and the multipliers, given A factored and w.r = r0.
+  void solveLaws(const SimTK::State& s, Work& w) const;
   void evalRows(const SimTK::State& s, std::vector<RowEval>& rows) const;
   Work& updWork(const SimTK::State& s) const;
   const Structure& getStructure(const SimTK::State& s, const std::vector<RowEval>& rows) const;
@@ -184,9 +221,11 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   std::vector<Arm> arms_;
   std::vector<Steer> steers_;
   std::vector<Speed> speeds_;
+  std::vector<Law> laws_;
   mutable SimTK::DiscreteVariableIndex activeIndex_;
   mutable SimTK::DiscreteVariableIndex releasedIndex_;  ///< std::vector<int>: 1 = the k-th hold released
   mutable SimTK::CacheEntryIndex lambdaIndex_;  ///< the multipliers (Stage::Dynamics)
+  mutable SimTK::CacheEntryIndex solvedIndex_;  ///< the laws' delta'' and the sweeps (Stage::Dynamics)
   mutable SimTK::CacheEntryIndex workIndex_;    ///< Work (Stage::Instance: its contents are scratch)
   mutable SimTK::CacheEntryIndex structureIndex_;  ///< Structure (Stage::Instance, lazy)
 };

@@ -173,7 +173,7 @@ struct Iso3888Run {
   bool pass = false;
   double exit_speed_m_s = NAN;        ///< at section 5's end (coasting slows the vehicle); NaN if not reached
   double max_path_error_m = 0;        ///< largest |path distance| of the tracked point
-  double peak_lateral_accel_m_s2 = 0; ///< of the controller's estimate
+  double peak_lateral_accel_m_s2 = 0; ///< largest |x''| normal to the velocity the controller uses, at the integrator's steps
   double peak_front_steer_deg = 0;
   /// The run's integrator counts; a failed run keeps its steps and wall time.
   RunSummary run;

@@ -9,12 +9,17 @@
 // The errors and their signs are the path's (vdyn/path/path.h: > 0 left of
 // the path), so positive gains steer back toward it.
 //
-// The chassis acceleration x'' of (7.13)-(7.16) cannot be the one Simbody
-// computes from this very law (x'' depends on delta''). The seed assumes it
-// changes smoothly; here the measured acceleration of the tracked point
-// enters through a first-order lag of time constant tau (two z variables,
-// a' = (x'' - a) / tau, integrated with error control), a stated choice
-// (acceleration_estimate "lagged"; "none" drops x''). The term matters: the
+// The chassis acceleration x'' of (7.13)-(7.16) depends on delta'' itself
+// (through the steering's inertia), so x'' and delta'' are one algebraic
+// loop. acceleration_estimate "solved" solves it: the vehicle's dense forward
+// dynamics finds delta'' and x'' together in each evaluation
+// (vdyn/vehicles/reduced_dense.h, a fixed point of this law and the equations
+// of motion), the seed's law as written; it needs that formulation (another
+// one stops the run with an error saying so). "lagged" breaks the loop: the
+// measured acceleration of the tracked point enters through a first-order lag
+// of time constant tau (two z variables, a' = (x'' - a) / tau, integrated with
+// error control); its mode at -1 / tau bounds an explicit integrator's step
+// (docs/benchmarks.md, "Closed loops"). "none" drops x''. The term matters: the
 // tire force answers a steering change at once, so x'' puts a term
 // proportional to delta into (7.17) and damps the fast loop
 // delta -> tire force -> e3 -> delta''. Estimating x'' from the yaw rate,
@@ -76,7 +81,7 @@ struct PathControlParams {
   double k4_rad_per_s2 = 5;         ///< K4, on e4 (slope at t + dT), rad/s^2 per unit slope (J-turn: per rad)
   double k5_per_s = 10;             ///< K5, the artificial damper on delta' (7.18), 1/s
   double look_ahead_s = 0.6;        ///< dT of (7.13)-(7.16), s (>= 0)
-  /// x'' in (7.13)-(7.16): "lagged" or "none" (see above).
+  /// x'' in (7.13)-(7.16): "solved", "lagged" or "none" (see above).
   std::string acceleration_estimate = "lagged";
   /// tau of the "lagged" estimate, s (> 0). It must stay well below the fast
   /// loop's period: on the bicycle at 10 m/s, 0.02 s already excites it (36 deg
@@ -140,9 +145,10 @@ struct PathFeedforwardParams {
   static const FieldTable<PathFeedforwardParams>& fields();
 };
 
-/// What the controller sees on a state (Stage::Velocity).
+/// What the controller sees on a state (Stage::Velocity; Stage::Acceleration
+/// for the "solved" estimate's a_G).
 struct PathControlEvaluation {
-  SimTK::Vec2 p_G{0, 0}, v_G{0, 0}, a_G{0, 0};  ///< tracked point's position, velocity, estimated acceleration
+  SimTK::Vec2 p_G{0, 0}, v_G{0, 0}, a_G{0, 0};  ///< tracked point's position, velocity, acceleration (estimated or solved)
   SimTK::Vec2 p_ahead_G{0, 0}, v_ahead_G{0, 0}; ///< predicted at t + dT (7.13)-(7.16)
   PathErrors now, ahead;                ///< (e1, e2) and (e3, e4)
   double steer_rate_rad_s = 0;          ///< delta'
@@ -168,13 +174,24 @@ class PathController : public SteeringLaw {
                  const PathFeedforwardParams& feedforward = {}, const SteeringActuator* rear = nullptr,
                  SimTK::Measure stage1 = {}, SimTK::Measure filtered = {},
                  std::function<double(double, double)> rearRatio = {}, SimTK::Measure referenceYawRate = {});
+  /// The evaluation with x'' as the estimate says: lagged (the z's), none
+  /// (0), or solved (the realized acceleration of the tracked point: the state
+  /// must be realized to Stage::Acceleration, else an Error saying why).
   PathControlEvaluation calcEvaluation(const SimTK::State& s) const;
+  /// The evaluation with the tracked point's measured acceleration x'' given
+  /// (m/s^2, Ground x and y), on a state realized to Stage::Velocity.
+  PathControlEvaluation calcEvaluationGiven(const SimTK::State& s, const SimTK::Vec2& xdd_G) const;
   const PathControlParams& params() const { return p_; }
   const PathFeedforwardParams& feedforward() const { return ff_; }
   const ReferencePath& path() const { return *path_; }
 
  protected:
   double DoCalcAcceleration(const SimTK::State& s) const override { return calcEvaluation(s).accel_rad_s2; }
+  /// "solved": the tracked point of the chassis.
+  bool DoGetStationAccelerationInput(StationAccelerationInput* input) const override;
+  double DoCalcAccelerationGiven(const SimTK::State& s, const SimTK::Vec3& a_G) const override {
+    return calcEvaluationGiven(s, SimTK::Vec2(a_G[0], a_G[1])).accel_rad_s2;
+  }
 
  private:
   PathControlParams p_;
@@ -182,7 +199,7 @@ class PathController : public SteeringLaw {
   SimTK::MobilizedBody chassis_;
   const SteeringActuator* steer_;  // owned by the same scene
   SimTK::Measure ax_, ay_;
-  bool lagged_ = false;
+  bool lagged_ = false, solved_ = false;
   PathFeedforwardParams ff_;
   const SteeringActuator* rear_ = nullptr;  // owned by the same scene
   SimTK::Measure stage1_, filtered_;
@@ -198,7 +215,8 @@ double calcFeedforwardTarget(const PathFeedforwardParams& ff, const ReferencePat
 
 /// Controller plugin: sets a PathController as the law of the named
 /// state-driven steering (any SteeringActuator). Outputs <name>.e1_m, .e2, .e3_m, .e4,
-/// .lateral_acceleration_m_s2 (the estimated x'' normal to the velocity),
+/// .lateral_acceleration_m_s2 (the estimated x'' normal to the velocity; with
+/// the "solved" estimate, .e3_m, .e4 and it are Stage::Acceleration outputs),
 /// .path_distance_m (signed closest-point distance of the tracked point to
 /// the path, the reported path error), .feedforward_rad (f) and
 /// .feedforward_target_rad (delta_ss; both 0 with no feed-forward).

@@ -135,7 +135,12 @@ class RearSteerLaw : public SteeringLaw {
   /// one driven by a law of its own, e.g. a path controller).
   RearSteerLaw(std::string name, std::shared_ptr<const RearSteerStrategy> strategy, const RearSteerParams& params,
                const SteeringActuator& front, const SteeringActuator& rear, const SimTK::MobilizedBody& chassis);
-  RearSteerEvaluation calcEvaluation(const SimTK::State& s) const;
+  /// The evaluation on a state realized to Stage::Velocity, the front's
+  /// delta'' from its steering (Stage::Dynamics where the vehicle's dense rows
+  /// solve it). Without `withFrontAcceleration` that is taken as 0: the
+  /// target's angle, rate and Kr do not depend on it; its acceleration and
+  /// accel_rad_s2 are then NaN.
+  RearSteerEvaluation calcEvaluation(const SimTK::State& s, bool withFrontAcceleration = true) const;
   const RearSteerStrategy& strategy() const { return *strategy_; }
 
  protected:

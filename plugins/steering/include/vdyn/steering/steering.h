@@ -23,6 +23,7 @@
 // angle cannot drift from the integrated delta beyond the constraint tolerance
 // (output <name>.drift_rad). Every term depends on q only, as Simbody's stages
 // require (z variables may only affect Dynamics and later).
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -245,6 +246,18 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
 
   /// State-driven only: the steer body (added to the scene as <name>.steer).
   const SimTK::MobilizedBody::Pin& getSteerBody() const;
+  /// State-driven only: the law a controller set (null before).
+  const SteeringLaw* getAccelerationLaw() const { return slot_->law.get(); }
+  /// A vehicle that solves this steering's delta'' with its own rows (the
+  /// dense forward dynamics, WheeledVehicle::useDenseRows: the steer body's
+  /// Motion disabled, delta'' a row of its system) says so here: in a state
+  /// where `solved(s)` is true, calcAcceleration() and the accel_rad_s2
+  /// output return `acceleration(s)`, the solved delta'' (rad/s^2).
+  struct ExternalSolve {
+    std::function<bool(const SimTK::State&)> solved;
+    std::function<double(const SimTK::State&)> acceleration;
+  };
+  void setExternalSolve(ExternalSolve solve) const { slot_->external = std::move(solve); }
 
   /// Drives the rack `rackBody` (a SteeringRack scene service of that name,
   /// set by the vehicle) instead of the knuckles; before the plugin is added.
@@ -292,6 +305,9 @@ class SteeringPlugin : public ConstraintPlugin, public SteeringActuator {
  private:
   struct LawSlot {
     std::shared_ptr<const SteeringLaw> law;
+    ExternalSolve external;
+    /// delta'' in `s`: the external solve's where it solves, else the law's.
+    double calcAcceleration(const SimTK::State& s, const std::string& who) const;
   };
   void addStateDriven(Scene& scene);
   void addRack(Scene& scene);
