@@ -1,5 +1,7 @@
 // Core: data-file errors, registry, integrator choice, recorder, scene costs.
+#include <algorithm>
 #include <cmath>
+#include <complex>
 #include <cstdlib>
 #include <fstream>
 #include <functional>
@@ -10,6 +12,7 @@
 #include "test_util.h"
 
 #include "vdyn/core/simulation.h"
+#include "vdyn/core/stiffness.h"
 #include "vdyn/plugins/builtin.h"
 #include "vdyn/vehicles/quarter_car.h"
 
@@ -122,13 +125,13 @@ TEST(Integrators, UnknownNameAndBadAccuracy) {
   IntegratorSettings s;
   s.method = "euler";
   EXPECT_EQ(errorOf([&] { s.validate(); }),
-            "unknown integrator 'euler'; known: rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2");
+            "unknown integrator 'euler'; known: auto, rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2");
   s.method = "rk3";
   s.accuracy = 2;
   EXPECT_EQ(errorOf([&] { s.validate(); }), "integrator accuracy must lie in (0, 1), got 2");
 }
 
-TEST(Integrators, AllSixAreConstructedWithTheirSettings) {
+TEST(Integrators, EveryNameIsConstructedWithItsSettings) {
   const QuarterCar car(parse(quarterCarJson()));
   for (const auto& name : integratorNames()) {
     IntegratorSettings s;
@@ -139,6 +142,50 @@ TEST(Integrators, AllSixAreConstructedWithTheirSettings) {
     EXPECT_EQ(integ->getAccuracyInUse(), 1e-5) << name;
     EXPECT_EQ(integ->getConstraintToleranceInUse(), 1e-10) << name;
   }
+}
+
+// RK Merson's stability function is its Taylor polynomial with Merson's fifth
+// coefficient, 1 + z + z^2/2 + z^3/6 + z^4/24 + z^5/144; its limit on the
+// negative real axis is the root of R(-x) = -1 (x = 3.5 to two figures).
+// The Jacobian of a damped oscillator on a slider (m x'' + c x' + k x = 0) has
+// the closed-form eigenvalues (-c +- sqrt(c^2 - 4 m k)) / (2 m).
+TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
+  using C = std::complex<double>;
+  for (C z : {C(-0.5, 0), C(-2, 1), C(-3.3, 0), C(0.1, 2.5)}) {
+    const C p = 1.0 + z + z * z / 2.0 + z * z * z / 6.0 + z * z * z * z / 24.0 + z * z * z * z * z / 144.0;
+    EXPECT_LT(std::abs(calcRkMersonStabilityFunction(z) - p), 1e-13 * std::abs(p)) << z;
+  }
+  double lo = 3, hi = 4;  // R(-x) + 1 changes sign in [3, 4]
+  for (int i = 0; i < 60; ++i) {
+    const double mid = 0.5 * (lo + hi);
+    (calcRkMersonStabilityFunction(-mid).real() > -1 ? lo : hi) = mid;
+  }
+  EXPECT_NEAR(lo, 3.5, 0.05);
+  C limiting;
+  EXPECT_NEAR(calcRkMersonStabilityLimit({C(-2, 0), C(-400, 0), C(0, 0), C(5, 0)}, &limiting), lo / 400, 1e-9 * lo);
+  EXPECT_EQ(limiting, C(-400, 0));
+  EXPECT_EQ(calcRkMersonStabilityLimit({C(0, 0), C(3, 1)}), std::numeric_limits<double>::infinity());
+
+  const double m = 2.0, k = 800.0, c = 90.0;  // kg, N/m, N s/m: overdamped
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter(system);
+  SimTK::GeneralForceSubsystem forces(system);
+  SimTK::MobilizedBody::Slider body(matter.Ground(), SimTK::MassProperties(m, SimTK::Vec3(0), SimTK::Inertia(1)));
+  SimTK::Force::MobilityLinearSpring(forces, body, SimTK::MobilizerQIndex(0), k, 0.0);
+  SimTK::Force::MobilityLinearDamper(forces, body, SimTK::MobilizerUIndex(0), c);
+  system.realizeTopology();
+  SimTK::State s = system.getDefaultState();
+  body.setQ(s, 0.01);
+  body.setU(s, -0.2);
+  long evaluations = 0;
+  std::vector<C> eig = calcEigenvalues(calcStateDerivativeJacobian(system, s, &evaluations));
+  EXPECT_EQ(evaluations, 3);
+  ASSERT_EQ(eig.size(), 2u);
+  std::sort(eig.begin(), eig.end(), [](C a, C b) { return a.real() < b.real(); });
+  const double d = std::sqrt(c * c - 4 * m * k);
+  EXPECT_NEAR(eig[0].real(), (-c - d) / (2 * m), 1e-5 * c / m);
+  EXPECT_NEAR(eig[1].real(), (-c + d) / (2 * m), 1e-5 * c / m);
+  EXPECT_EQ(eig[0].imag(), 0.0);
 }
 
 TEST(Scene, PaysOnlyForRequestedCosts) {

@@ -342,3 +342,51 @@ TEST(Formulation, StiffPeerSceneCpodes) {
   const long nRk = rk.result.summary["run"]["realizations"].get<long>();
   EXPECT_LT(nBdf, nRk / 2) << "cpodes " << nBdf << " evaluations, rk_merson " << nRk;
 }
+
+// The integrator "auto" (simulate(), vdyn/core/stiffness.h) finds the same
+// scene held by RK Merson's stability limit, set by the wheel-spin and slip
+// mode (a real eigenvalue near -396 1/s, limit h 9.0 ms), and goes on with
+// CPodes: fewer than half RK Merson's evaluations, the yaw rate within CPodes's
+// bound of the test above. On the chapter 3 transient (Gim tire with
+// relaxation) RK Merson's steps stay below 0.8 of the limit, which a lightly
+// damped mode sets: "auto" is RK Merson there, step for step (the same final
+// state to the bit), and pays one Jacobian (n + 1 evaluations) per check that
+// computes one.
+TEST(Formulation, AutoIntegratorGoesOnWithCpodesWhereRkMersonIsHeldByStability) {
+  const std::string peer = std::string(VDYN_TEST_DATA_DIR) + "/fiala_turn.json";
+  auto run = [&](const std::string& file, const std::string& method, double accuracy, double tEnd) {
+    return runFormulation(file, "dense",
+                          {{"analysis.integrator.method", method},
+                           {"analysis.integrator.accuracy", accuracy},
+                           {"analysis.t_end_s", tEnd}});
+  };
+  const char* k = "chassis.yaw_rate_rad_s";
+  const FormulationRun ref = run(peer, "rk_merson", 1e-10, 5), rk = run(peer, "rk_merson", 1e-6, 5),
+                       au = run(peer, "auto", 1e-6, 5);
+  const Json& runAuto = au.result.summary["run"];
+  const std::string choice = runAuto["integrator_choice"].get<std::string>();
+  EXPECT_EQ(runAuto["integrator"].get<std::string>(), "auto");
+  EXPECT_EQ(choice.rfind("rk_merson, then cpodes from at t = ", 0), 0u) << choice;
+  EXPECT_NE(choice.find("stability limit 0.0089"), std::string::npos) << choice;
+  EXPECT_NE(choice.find("(eigenvalue -39"), std::string::npos) << choice;
+  const double r0 = ref.result.summary["final"][k].get<double>();
+  EXPECT_NEAR(au.result.summary["final"][k].get<double>(), r0, 3e-5 * std::abs(r0));
+  const long nAuto = runAuto["realizations"].get<long>();
+  const long nRk = rk.result.summary["run"]["realizations"].get<long>();
+  EXPECT_LT(nAuto, nRk / 2) << "auto " << nAuto << " evaluations, rk_merson " << nRk;
+
+  const std::string ch3 = "scenes/ch3_transient.json";
+  const FormulationRun a3 = run(ch3, "auto", 1e-6, 10), r3 = run(ch3, "rk_merson", 1e-6, 10);
+  const Json& run3 = a3.result.summary["run"];
+  EXPECT_EQ(run3["integrator_choice"].get<std::string>().rfind("rk_merson (at t = ", 0), 0u)
+      << run3["integrator_choice"].get<std::string>();
+  for (const auto& [name, v] : r3.result.summary["final"].items())
+    EXPECT_EQ(a3.result.summary["final"][name].get<double>(), v.get<double>()) << name;
+  EXPECT_EQ(run3["steps"].get<long>(), r3.result.summary["run"]["steps"].get<long>());
+  const long extra = run3["realizations"].get<long>() - r3.result.summary["run"]["realizations"].get<long>();
+  const BuiltScene b = SceneDescription::fromFile(ch3, standardRegistry()).build();
+  const long n = b.scene().getDefaultState().getNY();
+  EXPECT_GT(extra, 0);
+  EXPECT_EQ(extra % (n + 1), 0) << extra << " extra evaluations, n = " << n;
+  EXPECT_LE(extra / (n + 1), 3) << "checks at steps 25, 100 and 400 of about 520";
+}

@@ -3,7 +3,7 @@
 namespace vdyn {
 
 const std::vector<std::string>& integratorNames() {
-  static const std::vector<std::string> names = {"rk_merson", "rk3", "rk_feldberg",
+  static const std::vector<std::string> names = {"auto", "rk_merson", "rk3", "rk_feldberg",
                                                  "cpodes", "verlet", "semi_explicit_euler2"};
   return names;
 }
@@ -65,7 +65,8 @@ std::unique_ptr<SimTK::Integrator> makeIntegrator(const SimTK::System& system,
                                                   const IntegratorSettings& s) {
   s.validate();
   std::unique_ptr<SimTK::Integrator> integ;
-  if (s.method == "rk_merson") integ.reset(new SimTK::RungeKuttaMersonIntegrator(system));
+  // "auto" starts as RK Merson; simulate() may go on with CPodes (stiffness.h).
+  if (s.method == "rk_merson" || s.method == "auto") integ.reset(new SimTK::RungeKuttaMersonIntegrator(system));
   else if (s.method == "rk3") integ.reset(new SimTK::RungeKutta3Integrator(system));
   else if (s.method == "rk_feldberg") integ.reset(new SimTK::RungeKuttaFeldbergIntegrator(system));
   else if (s.method == "cpodes") integ.reset(new SimTK::CPodesIntegrator(system, SimTK::CPodes::BDF, SimTK::CPodes::Newton));

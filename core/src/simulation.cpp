@@ -1,6 +1,7 @@
 #include <algorithm>
 #include "vdyn/core/simulation.h"
 #include "vdyn/core/interrupt.h"
+#include "vdyn/core/stiffness.h"
 
 #include <chrono>
 #include <cmath>
@@ -75,6 +76,11 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
 
   RunSummary sum;
   sum.integrator = s.integrator.method;
+  // The integrator "auto": RK Merson, and CPodes from the step where RK
+  // Merson's steps are found held by its stability limit (stiffness.h).
+  const bool autoMethod = s.integrator.method == "auto";
+  IntegratorSettings phase = s.integrator;
+  if (autoMethod) phase.method = "rk_merson";
   sum.accuracy = s.integrator.accuracy;
   if (const std::string caveat = errorEstimateCaveat(s.integrator); !caveat.empty()) {
     sum.warnings.push_back(caveat);
@@ -100,7 +106,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   double segEnd = ends[0];
   long doneSteps = 0, doneAttempts = 0, doneRealizations = 0, doneProjections = 0;  // of finished segments
 
-  auto integ = makeIntegrator(scene.getSystem(), s.integrator);
+  auto integ = makeIntegrator(scene.getSystem(), phase);
   integ->setReturnEveryInternalStep(true);
   integ->setFinalTime(segEnd);
   try {
@@ -120,9 +126,9 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     r.sim_time_s = simTime;
     r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   };
+  const bool reporting = recorder && s.report_interval_s > 0;
   try {
 
-    const bool reporting = recorder && s.report_interval_s > 0;
     if (reporting && (s.t_end_s - t0) / s.report_interval_s > double(s.max_samples))
       throw Error("simulate: report_interval_s = " + formatValue(s.report_interval_s) + " s gives " +
                   formatValue(std::ceil((s.t_end_s - t0) / s.report_interval_s)) + " samples over " +
@@ -138,7 +144,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     // (the samples read positions and velocities, no constraint needs them
     // exact). CPodes interpolates with its own polynomial: it stops at report
     // times and its interpolated states are not projected either.
-    const bool ownInterpolation = reporting && s.integrator.method != "cpodes";
+    bool ownInterpolation = reporting && phase.method != "cpodes";
     if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
     SimTK::Vector yPrev, ydotPrev;
     double tPrev = t0;
@@ -180,11 +186,48 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     auto lastProgress = wall0;
     auto stopped = [&](const std::string& guard) {
       const SimTK::State& at = integ->getState();
-      return Error("simulate: " + s.integrator.method + " at accuracy " + formatValue(s.integrator.accuracy) + ": " +
+      return Error("simulate: " + phase.method + " at accuracy " + formatValue(s.integrator.accuracy) + ": " +
                    guard + "; stopped at " + stateSummary(scene, at) + " after " +
                    std::to_string(integ->getNumStepsTaken()) + " steps (last step " +
                    formatValue(integ->getPreviousStepSizeTaken()) + " s) of the run to t_end " + formatValue(s.t_end_s) +
                    " s");
+    };
+    // The integrator "auto"'s test, after accepted RK Merson steps 25, 100,
+    // 400, ...: the largest of the last ten steps against RK Merson's
+    // stability limit at the step's end (one Jacobian, n + 1 evaluations; none
+    // while the steps stay below 0.4 of the last check's limit). A run whose
+    // steps reach 0.8 of it, set by a damped mode, is held by stability and
+    // goes on with CPodes (BDF, Newton), which steps past that mode.
+    constexpr int kRecent = 10;
+    double recent[kRecent] = {0};
+    long rkSteps = 0, nextCheck = 25;
+    double lastStable = 0;  // s, RK Merson's stability limit at the last check
+    auto checkStiffness = [&](const SimTK::State& adv, double h) {
+      recent[rkSteps % kRecent] = h;
+      if (++rkSteps != nextCheck) return false;
+      nextCheck *= 4;
+      const double hHeld = *std::max_element(recent, recent + kRecent);
+      // Far below the last check's limit (the limit would have had to fall by
+      // more than half since): no new Jacobian.
+      if (hHeld < 0.4 * lastStable) return false;
+      long evaluations = 0;
+      std::complex<double> lambda;
+      const double hStable = calcRkMersonStabilityLimit(
+          calcEigenvalues(calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations)), &lambda);
+      ownRealizations += int(evaluations);
+      lastStable = hStable;
+      char buf[320];
+      // Held: the steps reach 0.8 of the limit, and the mode that sets it is
+      // damped (damping ratio -Re/|lambda| >= 0.7): an oscillatory mode at the
+      // limit is one the implicit method would have to resolve as well.
+      const bool held = hHeld >= 0.8 * hStable && -lambda.real() >= 0.7 * std::abs(lambda);
+      std::snprintf(buf, sizeof buf,
+                    "at t = %.6g s: largest of the last %d steps %.3g s, RK Merson's stability limit %.3g s "
+                    "(eigenvalue %.4g%+.4gi 1/s)",
+                    adv.getTime(), kRecent, hHeld, hStable, lambda.real(), lambda.imag());
+      sum.integrator_choice = held ? std::string("rk_merson, then cpodes from ") + buf + ": held by stability"
+                                   : std::string("rk_merson (") + buf + ")";
+      return held;
     };
     for (;;) {
       SimTK::Integrator::SuccessfulStepStatus status;
@@ -195,7 +238,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         // message says only that it could not step on).
         std::string what = e.what();
         while (!what.empty() && (what.back() == '\n' || what.back() == ' ')) what.pop_back();
-        throw Error("simulate: " + s.integrator.method + " failed at t = " + formatValue(integ->getTime()) +
+        throw Error("simulate: " + phase.method + " failed at t = " + formatValue(integ->getTime()) +
                     " s; last accepted state: " + stateSummary(scene, integ->getState()) + " (last step " +
                     formatValue(integ->getPreviousStepSizeTaken()) + " s); " + what);
       }
@@ -215,6 +258,27 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         if (smallSteps >= s.min_step_count)
           throw stopped("step size collapsed: " + std::to_string(smallSteps) + " steps in a row shorter than min_step_s = " +
                         formatValue(s.min_step_s) + " s");
+        if (autoMethod && phase.method == "rk_merson" && adv.getTime() < segEnd - 1e-9 * std::max(1.0, std::abs(segEnd)) &&
+            checkStiffness(adv, h)) {
+          // Switch to CPodes at this step's end: the steps so far are counted
+          // as a finished segment's, and CPodes starts afresh (order 1) from here.
+          doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
+          doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+          const SimTK::State st = integ->getState();
+          phase.method = "cpodes";
+          integ = makeIntegrator(scene.getSystem(), phase);
+          integ->setReturnEveryInternalStep(true);
+          integ->setFinalTime(segEnd);
+          ownInterpolation = false;
+          if (reporting) integ->setProjectInterpolatedStates(false);
+          try {
+            integ->initialize(st);
+          } catch (const std::exception& e) {
+            throw Error("simulate: integrator auto: starting cpodes at t = " + formatValue(st.getTime()) +
+                        " s failed: " + e.what());
+          }
+          continue;
+        }
         if (s.wall_time_budget_s > 0 || s.progress) {
           const auto now = std::chrono::steady_clock::now();
           const double wall = std::chrono::duration<double>(now - wall0).count();
@@ -244,7 +308,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         try {
           integ->initialize(st);
         } catch (const std::exception& e) {
-          throw Error("simulate: restarting " + s.integrator.method + " at t = " + formatValue(st.getTime()) +
+          throw Error("simulate: restarting " + phase.method + " at t = " + formatValue(st.getTime()) +
                       " s (an input's rate jumps there) failed: " + e.what());
         }
         if (ownInterpolation) {
@@ -263,7 +327,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     }
     if (integ->isSimulationOver() &&
         integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
-      throw Error("simulate: " + s.integrator.method + " stopped early at t = " +
+      throw Error("simulate: " + phase.method + " stopped early at t = " +
                   formatValue(integ->getTime()) + " s (" +
                   SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");
 
@@ -276,6 +340,8 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   }
   state = integ->getState();
   fillCounts(sum, s.t_end_s - t0);
+  if (autoMethod && sum.integrator_choice.empty())
+    sum.integrator_choice = "rk_merson (the run ended before its first check at step 25)";
   if (partial) *partial = sum;
   return sum;
 }

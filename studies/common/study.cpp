@@ -250,8 +250,9 @@ void endProgress() {
 }
 
 void addIntegratorOptions(po::options_description& options) {
-  options.add_options()("integrator", po::value<std::string>(),
-                        "integrator: rk_merson, rk3, rk_feldberg, cpodes, verlet, semi_explicit_euler2")(
+  std::string names;
+  for (const auto& n : integratorNames()) names += (names.empty() ? "" : ", ") + n;
+  options.add_options()("integrator", po::value<std::string>(), ("integrator: " + names).c_str())(
       "accuracy", po::value<double>(), "integrator relative accuracy (dimensionless)");
 }
 

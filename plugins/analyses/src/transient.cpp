@@ -12,7 +12,8 @@ const FieldTable<TransientSettings>& TransientSettings::fields() {
           .number("report_interval_s", &TransientSettings::report_interval_s, "s",
                   "sampling interval of the recorded outputs (interpolated, never forces a step; 0 = none)")
           .custom("integrator", "-", "{\"method\": \"rk_merson\", \"accuracy\": 1e-6, \"constraint_tolerance\": 1e-10}",
-                  "integrator: method rk_merson|rk3|rk_feldberg|cpodes|verlet|semi_explicit_euler2, accuracy, "
+                  "integrator: method auto|rk_merson|rk3|rk_feldberg|cpodes|verlet|semi_explicit_euler2 (auto: RK "
+                  "Merson, CPodes from where RK Merson's steps are held by its stability limit), accuracy, "
                   "constraint_tolerance, max_step_s",
                   [](const ParamReader& r, TransientSettings& s) {
                     if (r.has("integrator")) s.integrator = IntegratorSettings::fromParams(r.child("integrator"));
@@ -91,6 +92,7 @@ Json summarizeTransient(const BuiltScene& built, const TransientSettings& settin
           {"integrals", integrals},
           {"run",
            {{"integrator", run.integrator},
+            {"integrator_choice", run.integrator_choice},
             {"accuracy", run.accuracy},
             {"steps", run.steps},
             {"attempts", run.attempts},

@@ -1,5 +1,9 @@
 #pragma once
-// Integrator choice by name. All six are Simbody's error-controlled integrators:
+// Integrator choice by name: Simbody's six error-controlled integrators, and "auto":
+//   auto                  RK Merson, switched by simulate() to CPodes from the
+//                         step where RK Merson's steps are held by its
+//                         stability limit (vdyn/core/stiffness.h); the run
+//                         summary's integrator_choice says when and why
 //   rk_merson             Runge-Kutta-Merson, 4th order (Simbody's default)
 //   rk3                   Runge-Kutta 3rd order
 //   rk_feldberg           Runge-Kutta-Fehlberg 4(5)

@@ -45,7 +45,10 @@ struct SimulationSettings {
 };
 
 struct RunSummary {
-  std::string integrator;
+  std::string integrator;  ///< as asked for (settings.integrator.method)
+  /// With the integrator "auto": which methods ran, from when, and why (the
+  /// steps against RK Merson's stability limit at the last check); else "".
+  std::string integrator_choice;
   double accuracy = 0;
   int steps = 0;              ///< accepted integrator steps
   int attempts = 0;           ///< attempted steps (accepted + rejected)
