@@ -366,7 +366,7 @@ TEST(Formulation, AutoIntegratorGoesOnWithCpodesWhereRkMersonIsHeldByStability) 
   const Json& runAuto = au.result.summary["run"];
   const std::string choice = runAuto["integrator_choice"].get<std::string>();
   EXPECT_EQ(runAuto["integrator"].get<std::string>(), "auto");
-  EXPECT_EQ(choice.rfind("rk_merson, then cpodes from at t = ", 0), 0u) << choice;
+  EXPECT_EQ(choice.rfind("rk_merson, then cpodes from t = ", 0), 0u) << choice;
   EXPECT_NE(choice.find("stability limit 0.0089"), std::string::npos) << choice;
   EXPECT_NE(choice.find("(eigenvalue -39"), std::string::npos) << choice;
   const double r0 = ref.result.summary["final"][k].get<double>();
@@ -378,7 +378,7 @@ TEST(Formulation, AutoIntegratorGoesOnWithCpodesWhereRkMersonIsHeldByStability) 
   const std::string ch3 = "scenes/ch3_transient.json";
   const FormulationRun a3 = run(ch3, "auto", 1e-6, 10), r3 = run(ch3, "rk_merson", 1e-6, 10);
   const Json& run3 = a3.result.summary["run"];
-  EXPECT_EQ(run3["integrator_choice"].get<std::string>().rfind("rk_merson (at t = ", 0), 0u)
+  EXPECT_EQ(run3["integrator_choice"].get<std::string>().rfind("rk_merson (the largest of the last 10 steps ", 0), 0u)
       << run3["integrator_choice"].get<std::string>();
   for (const auto& [name, v] : r3.result.summary["final"].items())
     EXPECT_EQ(a3.result.summary["final"][name].get<double>(), v.get<double>()) << name;
@@ -389,4 +389,26 @@ TEST(Formulation, AutoIntegratorGoesOnWithCpodesWhereRkMersonIsHeldByStability) 
   EXPECT_GT(extra, 0);
   EXPECT_EQ(extra % (n + 1), 0) << extra << " extra evaluations, n = " << n;
   EXPECT_LE(extra / (n + 1), 3) << "checks at steps 25, 100 and 400 of about 520";
+}
+
+// Where CPodes, once switched to, costs more than RK Merson did (the chapter 8
+// lane change on the 4WS car: the check finds a damped mode near -217 1/s at
+// RK Merson's limit, but the path law's fixed point makes CPodes's Newton
+// iterations fail), "auto" goes back to RK Merson for good once CPodes has
+// spent more than RK Merson's evaluation rate and the allowance give, so the
+// run costs at most a few percent more than RK Merson throughout and ends on
+// the same path (within the integrator's accuracy).
+TEST(Formulation, AutoIntegratorGoesBackToRkMersonWhereCpodesCostsMore) {
+  auto run = [&](const std::string& method) {
+    return runFormulation("scenes/ch8_maneuvers.json", "", {{"analysis.integrator.method", method}});
+  };
+  const FormulationRun au = run("auto"), rk = run("rk_merson");
+  const Json& ra = au.result.summary["run"];
+  const std::string choice = ra["integrator_choice"].get<std::string>();
+  EXPECT_EQ(choice.rfind("rk_merson, then cpodes from t = ", 0), 0u) << choice;
+  EXPECT_NE(choice.find("; back to rk_merson at t = "), std::string::npos) << choice;
+  const long nAuto = ra["realizations"].get<long>(), nRk = rk.result.summary["run"]["realizations"].get<long>();
+  EXPECT_LT(nAuto, 1.15 * nRk) << "auto " << nAuto << ", rk_merson " << nRk;
+  for (const char* k : {"chassis.y_m", "path_control.e1_m"})
+    EXPECT_NEAR(au.result.summary["final"][k].get<double>(), rk.result.summary["final"][k].get<double>(), 1e-6) << k;
 }

@@ -216,18 +216,74 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
           calcEigenvalues(calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations)), &lambda);
       ownRealizations += int(evaluations);
       lastStable = hStable;
-      char buf[320];
       // Held: the steps reach 0.8 of the limit, and the mode that sets it is
       // damped (damping ratio -Re/|lambda| >= 0.7): an oscillatory mode at the
       // limit is one the implicit method would have to resolve as well.
+      char buf[320];
       const bool held = hHeld >= 0.8 * hStable && -lambda.real() >= 0.7 * std::abs(lambda);
       std::snprintf(buf, sizeof buf,
-                    "at t = %.6g s: largest of the last %d steps %.3g s, RK Merson's stability limit %.3g s "
+                    "the largest of the last %d steps %.3g s at t = %.6g s, RK Merson's stability limit %.3g s "
                     "(eigenvalue %.4g%+.4gi 1/s)",
-                    adv.getTime(), kRecent, hHeld, hStable, lambda.real(), lambda.imag());
-      sum.integrator_choice = held ? std::string("rk_merson, then cpodes from ") + buf + ": held by stability"
+                    kRecent, hHeld, adv.getTime(), hStable, lambda.real(), lambda.imag());
+      char at[40];
+      std::snprintf(at, sizeof at, "%.6g", adv.getTime());
+      sum.integrator_choice = held ? std::string("rk_merson, then cpodes from t = ") + at + " s (" + buf +
+                                         ": held by stability)"
                                    : std::string("rk_merson (") + buf + ")";
       return held;
+    };
+    // After the switch CPodes must not spend more evaluations than RK Merson's
+    // rate before it (evaluations per simulated second, its checks included)
+    // would have over the same time, plus an allowance for its start (two
+    // Jacobians and 50 evaluations of order-1 steps); where it does (a closed
+    // loop whose law makes its Newton iterations fail), the run goes back to
+    // RK Merson for good. Counts, not times: the choice is the same on any machine.
+    bool cpodesTried = false;
+    double tSwitch = 0, rkRate = 0;
+    long cpodesAllowance = 0;
+    auto cpodesCostsMore = [&](const SimTK::State& adv) {
+      const double allowed = rkRate * (adv.getTime() - tSwitch) + double(cpodesAllowance);
+      if (!(double(integ->getNumRealizations()) > allowed)) return false;
+      char buf[240];
+      std::snprintf(buf, sizeof buf,
+                    "; back to rk_merson at t = %.6g s: cpodes took %d evaluations for %.3g s, where rk_merson's "
+                    "rate (%.4g / s) and the allowance give %.0f",
+                    adv.getTime(), integ->getNumRealizations(), adv.getTime() - tSwitch, rkRate, allowed);
+      sum.integrator_choice += buf;
+      return true;
+    };
+    // Goes on with `method` from the integrator's current state (a step's
+    // end): the steps so far count as a finished segment's, and the new
+    // integrator starts afresh there.
+    auto switchTo = [&](const std::string& method) {
+      doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
+      doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+      const SimTK::State st = integ->getState();
+      if (method == "cpodes") {
+        cpodesTried = true;
+        tSwitch = st.getTime();
+        rkRate = double(doneRealizations + ownRealizations) / (tSwitch - t0);
+        cpodesAllowance = 2 * (long(st.getNY()) + 1) + 50;
+      }
+      phase.method = method;
+      integ = makeIntegrator(scene.getSystem(), phase);
+      integ->setReturnEveryInternalStep(true);
+      integ->setFinalTime(segEnd);
+      ownInterpolation = reporting && method != "cpodes";
+      if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
+      try {
+        integ->initialize(st);
+      } catch (const std::exception& e) {
+        throw Error("simulate: integrator auto: starting " + method + " at t = " + formatValue(st.getTime()) +
+                    " s failed: " + e.what());
+      }
+      if (ownInterpolation) {
+        const SimTK::State& s1 = integ->getState();
+        scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
+        yPrev = s1.getY();
+        ydotPrev = s1.getYDot();
+        tPrev = s1.getTime();
+      }
     };
     for (;;) {
       SimTK::Integrator::SuccessfulStepStatus status;
@@ -258,26 +314,15 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         if (smallSteps >= s.min_step_count)
           throw stopped("step size collapsed: " + std::to_string(smallSteps) + " steps in a row shorter than min_step_s = " +
                         formatValue(s.min_step_s) + " s");
-        if (autoMethod && phase.method == "rk_merson" && adv.getTime() < segEnd - 1e-9 * std::max(1.0, std::abs(segEnd)) &&
-            checkStiffness(adv, h)) {
-          // Switch to CPodes at this step's end: the steps so far are counted
-          // as a finished segment's, and CPodes starts afresh (order 1) from here.
-          doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
-          doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
-          const SimTK::State st = integ->getState();
-          phase.method = "cpodes";
-          integ = makeIntegrator(scene.getSystem(), phase);
-          integ->setReturnEveryInternalStep(true);
-          integ->setFinalTime(segEnd);
-          ownInterpolation = false;
-          if (reporting) integ->setProjectInterpolatedStates(false);
-          try {
-            integ->initialize(st);
-          } catch (const std::exception& e) {
-            throw Error("simulate: integrator auto: starting cpodes at t = " + formatValue(st.getTime()) +
-                        " s failed: " + e.what());
+        if (autoMethod && adv.getTime() < segEnd - 1e-9 * std::max(1.0, std::abs(segEnd)) &&
+            !(reporting && !ownInterpolation && nextReport() < adv.getTime())) {
+          std::string next;
+          if (phase.method == "rk_merson" && !cpodesTried && checkStiffness(adv, h)) next = "cpodes";
+          if (phase.method == "cpodes" && cpodesCostsMore(adv)) next = "rk_merson";
+          if (!next.empty()) {
+            switchTo(next);
+            continue;
           }
-          continue;
         }
         if (s.wall_time_budget_s > 0 || s.progress) {
           const auto now = std::chrono::steady_clock::now();

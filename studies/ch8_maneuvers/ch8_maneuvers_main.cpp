@@ -140,6 +140,8 @@ RunResult runOne(const SceneDescription& base, const Scenario& sc, const std::st
                                                        study::maxAbs(rec.column("rear_steer.drift_rad")))},
                       {"max_constraint_error", run.max_constraint_error},
                       {"steps", run.steps},
+                      {"realizations", run.realizations},
+                      {"integrator_choice", run.integrator_choice},
                       {"peak_feedforward_deg", study::maxAbs(rec.column("path_control.feedforward_rad")) * kDeg},
                       {"sim_time_s", run.sim_time_s},
                       {"wall_time_s", run.wall_time_s}});
