@@ -186,6 +186,10 @@ TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
   EXPECT_NEAR(eig[0].real(), (-c - d) / (2 * m), 1e-5 * c / m);
   EXPECT_NEAR(eig[1].real(), (-c + d) / (2 * m), 1e-5 * c / m);
   EXPECT_EQ(eig[0].imag(), 0.0);
+  Eigen::MatrixXd bad = Eigen::MatrixXd::Identity(2, 2);
+  bad(0, 1) = std::nan("");
+  EXPECT_EQ(errorOf([&] { calcEigenvalues(bad); }),
+            "stiffness: the Jacobian of the state derivative has a non-finite entry");
 }
 
 TEST(Scene, PaysOnlyForRequestedCosts) {

@@ -200,6 +200,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     // goes on with CPodes (BDF, Newton), which steps past that mode.
     constexpr int kRecent = 10;
     double recent[kRecent] = {0};
+    bool cpodesTried = false;  // or a check failed: no more checks
     long rkSteps = 0, nextCheck = 25;
     double lastStable = 0;  // s, RK Merson's stability limit at the last check
     auto checkStiffness = [&](const SimTK::State& adv, double h) {
@@ -212,8 +213,18 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       if (hHeld < 0.4 * lastStable) return false;
       long evaluations = 0;
       std::complex<double> lambda;
-      const double hStable = calcRkMersonStabilityLimit(
-          calcEigenvalues(calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations)), &lambda);
+      double hStable = 0;
+      try {
+        hStable = calcRkMersonStabilityLimit(
+            calcEigenvalues(calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations)), &lambda);
+      } catch (const std::exception& e) {
+        // A diagnostic does not end a run: RK Merson goes on, unchecked, and the summary says why.
+        char at[40];
+        std::snprintf(at, sizeof at, "%.6g", adv.getTime());
+        sum.integrator_choice = std::string("rk_merson (the stiffness check at t = ") + at + " s failed: " + e.what() + ")";
+        cpodesTried = true;
+        return false;
+      }
       ownRealizations += int(evaluations);
       lastStable = hStable;
       // Held: the steps reach 0.8 of the limit, and the mode that sets it is
@@ -238,7 +249,6 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     // Jacobians and 50 evaluations of order-1 steps); where it does (a closed
     // loop whose law makes its Newton iterations fail), the run goes back to
     // RK Merson for good. Counts, not times: the choice is the same on any machine.
-    bool cpodesTried = false;
     double tSwitch = 0, rkRate = 0;
     long cpodesAllowance = 0;
     auto cpodesCostsMore = [&](const SimTK::State& adv) {

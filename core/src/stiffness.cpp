@@ -6,6 +6,8 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "vdyn/core/error.h"
+
 namespace vdyn {
 
 Eigen::MatrixXd calcStateDerivativeJacobian(const SimTK::System& system, const SimTK::State& at, long* evaluations) {
@@ -28,7 +30,11 @@ Eigen::MatrixXd calcStateDerivativeJacobian(const SimTK::System& system, const S
 }
 
 std::vector<std::complex<double>> calcEigenvalues(const Eigen::MatrixXd& jacobian) {
+  if (!jacobian.allFinite()) throw Error("stiffness: the Jacobian of the state derivative has a non-finite entry");
   Eigen::EigenSolver<Eigen::MatrixXd> es(jacobian, /*computeEigenvectors=*/false);
+  if (es.info() != Eigen::Success)
+    throw Error("stiffness: the eigenvalues of the " + std::to_string(jacobian.rows()) + " x " +
+                std::to_string(jacobian.cols()) + " Jacobian did not converge");
   const auto& v = es.eigenvalues();
   return std::vector<std::complex<double>>(v.data(), v.data() + v.size());
 }

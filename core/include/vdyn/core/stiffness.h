@@ -23,7 +23,8 @@ namespace vdyn {
 Eigen::MatrixXd calcStateDerivativeJacobian(const SimTK::System& system, const SimTK::State& at,
                                             long* evaluations = nullptr);
 
-/// Eigenvalues (1/s) of a square matrix.
+/// Eigenvalues (1/s) of a square matrix; throws Error if an entry is not
+/// finite or the QR iterations do not converge.
 std::vector<std::complex<double>> calcEigenvalues(const Eigen::MatrixXd& jacobian);
 
 /// Stability function R(z) of Simbody's RK Merson step (its five stages and its
