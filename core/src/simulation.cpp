@@ -265,9 +265,30 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     // Goes on with `method` from the integrator's current state (a step's
     // end): the steps so far count as a finished segment's, and the new
     // integrator starts afresh there.
-    auto switchTo = [&](const std::string& method) {
+    // The integrator's counts so far into those of finished segments.
+    auto closeCounts = [&] {
       doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
       doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+    };
+    // Starts the integrator at `st` (its initialization projects and realizes
+    // the first stage), and the own interpolation there; `what` and `why` go
+    // into the message if it fails.
+    auto startAt = [&](const SimTK::State& st, const std::string& what, const std::string& why) {
+      try {
+        integ->initialize(st);
+      } catch (const std::exception& e) {
+        throw Error("simulate: " + what + " at t = " + formatValue(st.getTime()) + " s" + why + " failed: " + e.what());
+      }
+      if (ownInterpolation) {
+        const SimTK::State& s1 = integ->getState();
+        scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
+        yPrev = s1.getY();
+        ydotPrev = s1.getYDot();
+        tPrev = s1.getTime();
+      }
+    };
+    auto switchTo = [&](const std::string& method) {
+      closeCounts();
       const SimTK::State st = integ->getState();
       if (method == "cpodes") {
         cpodesTried = true;
@@ -281,19 +302,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       integ->setFinalTime(segEnd);
       ownInterpolation = reporting && method != "cpodes";
       if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
-      try {
-        integ->initialize(st);
-      } catch (const std::exception& e) {
-        throw Error("simulate: integrator auto: starting " + method + " at t = " + formatValue(st.getTime()) +
-                    " s failed: " + e.what());
-      }
-      if (ownInterpolation) {
-        const SimTK::State& s1 = integ->getState();
-        scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
-        yPrev = s1.getY();
-        ydotPrev = s1.getYDot();
-        tPrev = s1.getTime();
-      }
+      startAt(st, "integrator auto: starting " + method, "");
     };
     for (;;) {
       SimTK::Integrator::SuccessfulStepStatus status;
@@ -354,25 +363,12 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       const double segTol = 1e-12 * std::max(1.0, std::abs(segEnd));
       if (seg + 1 < ends.size() && (status == S::EndOfSimulation || integ->getTime() >= segEnd - segTol)) {
         // A restart: the next segment starts at the restart time itself (its input from the right).
-        doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
-        doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+        closeCounts();
         SimTK::State st = integ->getState();
         st.setTime(segEnd);
         segEnd = ends[++seg];
         integ->setFinalTime(segEnd);
-        try {
-          integ->initialize(st);
-        } catch (const std::exception& e) {
-          throw Error("simulate: restarting " + phase.method + " at t = " + formatValue(st.getTime()) +
-                      " s (an input's rate jumps there) failed: " + e.what());
-        }
-        if (ownInterpolation) {
-          const SimTK::State& s1 = integ->getState();
-          scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
-          yPrev = s1.getY();
-          ydotPrev = s1.getYDot();
-          tPrev = s1.getTime();
-        }
+        startAt(st, "restarting " + phase.method, " (an input's rate jumps there)");
         continue;
       }
       if (status == S::EndOfSimulation || integ->getTime() >= s.t_end_s - tEndTol) {
