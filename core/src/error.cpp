@@ -21,30 +21,28 @@ std::string formatValue(double v) {
   return buf;
 }
 
-double requireFinite(double v, const std::string& name) {
-  if (!std::isfinite(v))
-    throw Error(name + " must be a finite number, got " + formatValue(v));
-  return v;
+namespace detail {
+
+void throwNotFinite(double v, std::string_view name) {
+  throw Error(std::string(name) + " must be a finite number, got " + formatValue(v));
 }
 
-double requirePositive(double v, const std::string& name) {
-  requireFinite(v, name);
-  if (!(v > 0)) throw Error(name + " must be positive, got " + formatValue(v));
-  return v;
+void throwNotPositive(double v, std::string_view name) {
+  if (!std::isfinite(v)) throwNotFinite(v, name);
+  throw Error(std::string(name) + " must be positive, got " + formatValue(v));
 }
 
-double requireNonNegative(double v, const std::string& name) {
-  requireFinite(v, name);
-  if (v < 0) throw Error(name + " must not be negative, got " + formatValue(v));
-  return v;
+void throwNegative(double v, std::string_view name) {
+  if (!std::isfinite(v)) throwNotFinite(v, name);
+  throw Error(std::string(name) + " must not be negative, got " + formatValue(v));
 }
 
-double requireInRange(double v, double lo, double hi, const std::string& name) {
-  requireFinite(v, name);
-  if (v < lo || v > hi)
-    throw Error(name + " must lie in [" + formatValue(lo) + ", " + formatValue(hi) +
-                "], got " + formatValue(v));
-  return v;
+void throwOutOfRange(double v, double lo, double hi, std::string_view name) {
+  if (!std::isfinite(v)) throwNotFinite(v, name);
+  throw Error(std::string(name) + " must lie in [" + formatValue(lo) + ", " + formatValue(hi) + "], got " +
+              formatValue(v));
 }
+
+}  // namespace detail
 
 }  // namespace vdyn

@@ -6,6 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <string_view>
 
 #include "vdyn/core/config.h"
 
@@ -23,13 +24,37 @@ std::string oneLineMessage(const std::exception& e);
 /// Formats a double the way error messages quote values (shortest round trip).
 std::string formatValue(double v);
 
+namespace detail {
+// The messages of the checks below, built only when a check fails.
+[[noreturn]] void throwNotFinite(double v, std::string_view name);
+[[noreturn]] void throwNotPositive(double v, std::string_view name);
+[[noreturn]] void throwNegative(double v, std::string_view name);
+[[noreturn]] void throwOutOfRange(double v, double lo, double hi, std::string_view name);
+}  // namespace detail
+
+// The checks are inline and take the name as a view: they sit in evaluation
+// paths (a tire's or a law's inputs at every evaluation), where building a
+// std::string from the name's literal cost an allocation per call.
+
 /// Throws Error("<name> must be a finite number, got <v>") unless v is finite.
-double requireFinite(double v, const std::string& name);
+inline double requireFinite(double v, std::string_view name) {
+  if (!std::isfinite(v)) detail::throwNotFinite(v, name);
+  return v;
+}
 /// Throws unless v is finite and > 0.
-double requirePositive(double v, const std::string& name);
+inline double requirePositive(double v, std::string_view name) {
+  if (!(v > 0 && std::isfinite(v))) detail::throwNotPositive(v, name);
+  return v;
+}
 /// Throws unless v is finite and >= 0.
-double requireNonNegative(double v, const std::string& name);
+inline double requireNonNegative(double v, std::string_view name) {
+  if (!(v >= 0 && std::isfinite(v))) detail::throwNegative(v, name);
+  return v;
+}
 /// Throws unless v is finite and lo <= v <= hi.
-double requireInRange(double v, double lo, double hi, const std::string& name);
+inline double requireInRange(double v, double lo, double hi, std::string_view name) {
+  if (!(v >= lo && v <= hi && std::isfinite(v))) detail::throwOutOfRange(v, lo, hi, name);
+  return v;
+}
 
 }  // namespace vdyn

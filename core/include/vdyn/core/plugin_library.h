@@ -30,9 +30,10 @@
 /// and SteeringCommand::getRateJumpTimes. 6: Plugin::addDecorations (animations),
 /// Scene's sample observer. 7: the sample observer moved from Scene to
 /// Recorder's constructor (AnalysisContext::animation), SceneDecorations'
-/// cone size. A library must return the value it was compiled with from
+/// cone size. 9: the require* checks (vdyn/core/error.h) inline, taking the
+/// name as a std::string_view. A library must return the value it was compiled with from
 /// vdyn_plugin_abi_version().
-#define VDYN_PLUGIN_ABI_VERSION 8
+#define VDYN_PLUGIN_ABI_VERSION 9
 
 /// Declares the two entry points with C linkage and default visibility.
 #define VDYN_PLUGIN_EXPORT extern "C" __attribute__((visibility("default")))
