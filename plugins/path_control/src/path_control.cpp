@@ -163,18 +163,20 @@ bool PathController::DoGetStationAccelerationInput(StationAccelerationInput* inp
   return true;
 }
 
-PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s) const {
-  if (!solved_) return calcEvaluationGiven(s, lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0));
+PathControlEvaluation PathController::calcEvaluation(const SimTK::State& s, bool withTarget) const {
+  if (!solved_)
+    return calcEvaluationGiven(s, lagged_ ? Vec2(ax_.getValue(s), ay_.getValue(s)) : Vec2(0, 0), withTarget);
   if (s.getSystemStage() < SimTK::Stage::Acceleration)
     throw Error("path controller '" + name() + "': acceleration_estimate \"solved\" needs x'' and delta'' solved "
                 "together, which the vehicle's dense forward dynamics does (formulation \"auto\" or \"dense\"); "
                 "here delta'' was asked before the accelerations (t = " + formatValue(s.getTime()) +
                 " s): use acceleration_estimate \"lagged\" with this formulation");
   const Vec3 a = chassis_.findStationAccelerationInGround(s, p_.tracked_point_m);
-  return calcEvaluationGiven(s, Vec2(a[0], a[1]));
+  return calcEvaluationGiven(s, Vec2(a[0], a[1]), withTarget);
 }
 
-PathControlEvaluation PathController::calcEvaluationGiven(const SimTK::State& s, const Vec2& xdd_G) const {
+PathControlEvaluation PathController::calcEvaluationGiven(const SimTK::State& s, const Vec2& xdd_G,
+                                                          bool withTarget) const {
   PathControlEvaluation e;
   const Vec3 p = chassis_.findStationLocationInGround(s, p_.tracked_point_m),
              v = chassis_.findStationVelocityInGround(s, p_.tracked_point_m);
@@ -207,7 +209,7 @@ PathControlEvaluation PathController::calcEvaluationGiven(const SimTK::State& s,
                    p_.k5_per_s * e.steer_rate_rad_s;
   if (ff_.enabled()) {
     // The feed-forward through the damper: -K5 (delta' - f') (header, docs/path_feedforward.md).
-    e.feedforward_target_rad = calcFeedforwardTarget(ff_, *path_, e.p_G, e.v_G, rear, &ratio_);
+    if (withTarget) e.feedforward_target_rad = calcFeedforwardTarget(ff_, *path_, e.p_G, e.v_G, rear, &ratio_);
     e.feedforward_rate_rad_s = (stage1_.getValue(s) - e.feedforward_rad) / ff_.lag_s;
     e.accel_rad_s2 += p_.k5_per_s * e.feedforward_rate_rad_s;
     if (!yawRef_.isEmptyHandle()) {
@@ -457,13 +459,16 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   // Outputs of what x'' moves (e3, e4, x'' itself) need Stage::Acceleration
   // with the "solved" estimate; the others are read with x'' = 0 there.
   const bool solved = p_.acceleration_estimate == "solved";
+  // Only feedforward_target_rad's evaluation solves for delta_ss (withTarget).
   auto add = [&](const std::string& key, const std::string& unit, bool readsXdd, auto f) {
+    const bool target = key == "feedforward_target_rad";
     if (solved && !readsXdd)
-      scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity,
-                       [law, f](const SimTK::State& s) { return f(law->calcEvaluationGiven(s, Vec2(0, 0))); }});
+      scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity, [law, f, target](const SimTK::State& s) {
+                         return f(law->calcEvaluationGiven(s, Vec2(0, 0), target));
+                       }});
     else
       scene.addOutput({name() + "." + key, unit, solved ? SimTK::Stage::Acceleration : SimTK::Stage::Velocity,
-                       [law, f](const SimTK::State& s) { return f(law->calcEvaluation(s)); }});
+                       [law, f, target](const SimTK::State& s) { return f(law->calcEvaluation(s, target)); }});
   };
   add("e1_m", "m", false, [](const PathControlEvaluation& e) { return e.now.position_m; });
   add("e2", "1", false, [](const PathControlEvaluation& e) { return e.now.slope; });

@@ -177,20 +177,24 @@ class PathController : public SteeringLaw {
   /// The evaluation with x'' as the estimate says: lagged (the z's), none
   /// (0), or solved (the realized acceleration of the tracked point: the state
   /// must be realized to Stage::Acceleration, else an Error saying why).
-  PathControlEvaluation calcEvaluation(const SimTK::State& s) const;
+  /// `withTarget` false leaves feedforward_target_rad at 0: delta'' does not
+  /// use it (it is an output), and its fixed point is the costliest part of an
+  /// evaluation, which the dense rows' sweeps repeat per iterate of x''.
+  PathControlEvaluation calcEvaluation(const SimTK::State& s, bool withTarget = true) const;
   /// The evaluation with the tracked point's measured acceleration x'' given
   /// (m/s^2, Ground x and y), on a state realized to Stage::Velocity.
-  PathControlEvaluation calcEvaluationGiven(const SimTK::State& s, const SimTK::Vec2& xdd_G) const;
+  PathControlEvaluation calcEvaluationGiven(const SimTK::State& s, const SimTK::Vec2& xdd_G,
+                                            bool withTarget = true) const;
   const PathControlParams& params() const { return p_; }
   const PathFeedforwardParams& feedforward() const { return ff_; }
   const ReferencePath& path() const { return *path_; }
 
  protected:
-  double DoCalcAcceleration(const SimTK::State& s) const override { return calcEvaluation(s).accel_rad_s2; }
+  double DoCalcAcceleration(const SimTK::State& s) const override { return calcEvaluation(s, false).accel_rad_s2; }
   /// "solved": the tracked point of the chassis.
   bool DoGetStationAccelerationInput(StationAccelerationInput* input) const override;
   double DoCalcAccelerationGiven(const SimTK::State& s, const SimTK::Vec3& a_G) const override {
-    return calcEvaluationGiven(s, SimTK::Vec2(a_G[0], a_G[1])).accel_rad_s2;
+    return calcEvaluationGiven(s, SimTK::Vec2(a_G[0], a_G[1]), false).accel_rad_s2;
   }
 
  private:
