@@ -502,22 +502,39 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
     }
   }
   // Gauss-Seidel sweeps over the laws (the others' delta'' read through
-  // ExternalSolve: w.x while solving).
+  // ExternalSolve: w.x while solving), accelerated: a sweep maps its start x
+  // to g, and the next sweep starts from the combination of the last sweeps'
+  // g that makes their combined residual g - x least (Anderson acceleration
+  // with up to nL differences kept (8 at most): for laws affine in x'' and in the other
+  // laws' delta'', as the path and rear-steer laws are, the start of sweep
+  // nL + 2 is the fixed point to rounding, and that sweep confirms it). A
+  // sweep whose residual grew starts the history afresh (a plain sweep). The
+  // result is the last sweep's g, accepted as before when it moved less than
+  // 1e-10 (1 + |delta''|) from its start.
   struct Solving {
     Work& w;
     ~Solving() { w.solving = false; }
   } solving{w};
   w.x.assign(nL, 0.0);
+  w.start.assign(nL, 0.0);
+  w.f.resize(nL);
+  w.gPrev.resize(nL);
+  w.fPrev.resize(nL);
+  w.dG.clear();
+  w.dF.clear();
   w.solving = true;
   constexpr int kMaxSweeps = 50;
   constexpr double kTolerance = 1e-10;  // relative to 1 + |x|, rad/s^2: above the laws' rounding (1e-12 seen)
-  int sweeps = 0;
-  double change = 0;
-  for (bool done = false; !done;) {
+  const int memory = std::min(nL, 8);  // differences kept
+  int sweeps = 0, kept = 0;
+  double change = 0, residual = 0, residualPrev = HUGE_VAL;
+  for (;;) {
     if (++sweeps > kMaxSweeps)
       throw Error("reduced dense dynamics: the steering laws' delta'' did not settle in " + std::to_string(kMaxSweeps) +
                   " sweeps at t = " + formatValue(s.getTime()) + " s (last relative change " + formatValue(change) + ")");
+    w.x = w.start;
     change = 0;
+    residual = 0;
     for (int k = 0; k < nL; ++k) {
       const SteeringLaw* law = laws_[k].plugin->getAccelerationLaw();
       double v;
@@ -528,10 +545,89 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
       } else {
         v = law->calcAcceleration(s);
       }
-      change = std::max(change, std::abs(v - w.x[k]) / (1 + std::abs(v)));
+      w.f[k] = v - w.start[k];
+      change = std::max(change, std::abs(w.f[k]) / (1 + std::abs(v)));
+      residual = std::max(residual, std::abs(w.f[k]));
       w.x[k] = v;
     }
-    done = change <= kTolerance;
+    if (change <= kTolerance) break;
+    // The next start: g - dG gamma, gamma the least-squares solution of
+    // dF gamma = f over the kept differences (normal equations; a history
+    // whose equations are singular, or a sweep whose residual grew, is dropped).
+    if (sweeps > 1) {
+      if (!(residual < residualPrev)) {
+        kept = 0;
+      } else {
+        if (kept == memory) {  // the oldest difference out
+          w.dG.erase(w.dG.begin(), w.dG.begin() + nL);
+          w.dF.erase(w.dF.begin(), w.dF.begin() + nL);
+          --kept;
+        }
+        w.dG.resize(std::size_t(kept + 1) * nL);
+        w.dF.resize(std::size_t(kept + 1) * nL);
+        for (int k = 0; k < nL; ++k) {
+          w.dG[std::size_t(kept) * nL + k] = w.x[k] - w.gPrev[k];
+          w.dF[std::size_t(kept) * nL + k] = w.f[k] - w.fPrev[k];
+        }
+        ++kept;
+      }
+      w.dG.resize(std::size_t(kept) * nL);
+      w.dF.resize(std::size_t(kept) * nL);
+    }
+    w.gPrev = w.x;
+    w.fPrev = w.f;
+    residualPrev = residual;
+    w.start = w.x;
+    if (kept > 0) {
+      double M[8][9];  // [dF^T dF | dF^T f]
+      const int q = kept;
+      const double* dF = w.dF.data();
+      const double* dG = w.dG.data();
+      for (int i = 0; i < q; ++i) {
+        for (int j = 0; j < q; ++j) {
+          double a = 0;
+          for (int k = 0; k < nL; ++k) a += dF[std::size_t(i) * nL + k] * dF[std::size_t(j) * nL + k];
+          M[i][j] = a;
+        }
+        double b = 0;
+        for (int k = 0; k < nL; ++k) b += dF[std::size_t(i) * nL + k] * w.f[k];
+        M[i][q] = b;
+      }
+      // Gaussian elimination with partial pivoting; a pivot below 1e-12 of
+      // the largest diagonal entry: singular (the history is dropped).
+      double scale = 0;
+      for (int i = 0; i < q; ++i) scale = std::max(scale, M[i][i]);
+      bool singular = !(scale > 0);
+      for (int col = 0; col < q && !singular; ++col) {
+        int piv = col;
+        for (int i = col + 1; i < q; ++i)
+          if (std::abs(M[i][col]) > std::abs(M[piv][col])) piv = i;
+        if (!(std::abs(M[piv][col]) > 1e-12 * scale)) {
+          singular = true;
+          break;
+        }
+        if (piv != col)
+          for (int j = col; j <= q; ++j) std::swap(M[col][j], M[piv][j]);
+        for (int i = col + 1; i < q; ++i) {
+          const double r = M[i][col] / M[col][col];
+          for (int j = col; j <= q; ++j) M[i][j] -= r * M[col][j];
+        }
+      }
+      if (singular) {
+        kept = 0;
+        w.dG.clear();
+        w.dF.clear();
+      } else {
+        double gamma[8];
+        for (int i = q - 1; i >= 0; --i) {
+          double v = M[i][q];
+          for (int j = i + 1; j < q; ++j) v -= M[i][j] * gamma[j];
+          gamma[i] = v / M[i][i];
+        }
+        for (int j = 0; j < q; ++j)
+          for (int k = 0; k < nL; ++k) w.start[k] -= gamma[j] * dG[std::size_t(j) * nL + k];
+      }
+    }
   }
   for (int i = 0; i < m; ++i) {
     double l = w.lam0[i];

@@ -203,6 +203,9 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
     bool haveS = false;
     // The laws' solve: x their delta'', solving while it runs.
     std::vector<double> x, lam0, Lam, Z;
+    // Its acceleration (solveLaws): a sweep's start and residual, the last
+    // one's output and residual, and the differences kept (column-major, nL each).
+    std::vector<double> start, f, gPrev, fPrev, dG, dF;
     bool solving = false;
   };
   /// The laws' solve and the multipliers, given A factored and w.r = r0.
