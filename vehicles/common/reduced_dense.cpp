@@ -104,7 +104,7 @@ void ReducedDenseRows::evalRows(const SimTK::State& s, std::vector<RowEval>& row
     {
       RowEval& r = rows[i++];
       const int uu = a.upper.getFirstUIndex(s);
-      const Vec3 t4 = a.loop->calcUpperArmAngle(sq);
+      const Vec3 t4 = a.mobilizer->getUpperArmAngle(s);
       r.n = 2;
       r.u[0] = uu, r.g[0] = 1, r.body[0] = bu, r.ux[0] = 0;
       r.u[1] = us, r.g[1] = -t4[1], r.body[1] = bk, r.ux[1] = 0;

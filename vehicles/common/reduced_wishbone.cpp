@@ -258,6 +258,7 @@ ReducedKnuckleMobilizer::Kinematics ReducedKnuckleMobilizer::calcKinematics(doub
       for (int h = 0; h < 3; ++h) ddR[h](i, j) = e.h[h];
     }
   K.X = SimTK::Transform(SimTK::Rotation(R, true), Vec3(P.p[0].v, P.p[1].v, P.p[2].v));
+  K.theta4 = Vec3(P.theta4.v, P.theta4.d[0], P.theta4.h[0]);
   const SimTK::Mat33 Rt = R.transpose();
   // w_j = vee(dR_j R^T); d w_j / d q_k = vee(d2R_jk R^T + dR_j dR_k^T).
   auto vee = [](const SimTK::Mat33& W) {
@@ -450,6 +451,7 @@ ReducedWishboneCorner buildReducedWishbone(Scene& scene, SimTK::MobilizedBody& c
   buildWishboneCorner(scene, chassis, p, prefix, c, [&](ReducedWishboneCorner& k) {
     auto* impl = new ReducedKnuckleMobilizer(scene.updMatter(), loop);
     k.knuckle = SimTK::MobilizedBody::Custom(chassis, impl, makeRigidBody(p.knuckle));
+    k.knuckle_mobilizer = impl;
     impl->setMobilizedBody(k.knuckle.getMobilizedBodyIndex());
   });
   return c;

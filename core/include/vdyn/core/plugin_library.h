@@ -31,7 +31,8 @@
 /// Scene's sample observer. 7: the sample observer moved from Scene to
 /// Recorder's constructor (AnalysisContext::animation), SceneDecorations'
 /// cone size. 9: the require* checks (vdyn/core/error.h) inline, taking the
-/// name as a std::string_view. A library must return the value it was compiled with from
+/// name as a std::string_view; ReducedDenseRows::Arm names the knuckle's
+/// ReducedKnuckleMobilizer (was its WishboneLoop). A library must return the value it was compiled with from
 /// vdyn_plugin_abi_version().
 #define VDYN_PLUGIN_ABI_VERSION 9
 

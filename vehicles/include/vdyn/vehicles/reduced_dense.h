@@ -89,7 +89,9 @@ class ReducedDenseRows : public SimTK::Force::Custom::Implementation {
   struct Arm {
     SimTK::MobilizedBody::Pin lower, upper;
     SimTK::MobilizedBody::Custom knuckle;
-    const WishboneLoop* loop = nullptr;
+    /// The knuckle's implementation (owned by the matter subsystem): the
+    /// upper arm's row reads theta4(s) from the kinematics its State holds.
+    const ReducedKnuckleMobilizer* mobilizer = nullptr;
   };
   /// A steered knuckle: time-commanded (`command`), or state-driven (no
   /// command; `steer` the steering plugin's steer body, whose Motion

@@ -107,8 +107,12 @@ class ReducedKnuckleMobilizer : public SimTK::MobilizedBody::Custom::Implementat
     SimTK::Transform X;
     SimTK::SpatialVec H[2];
     SimTK::SpatialVec dH[2][2];  ///< dH[j][k] = d(H column j) / d q_k
+    SimTK::Vec3 theta4;          ///< the upper arm angle theta4(s), d/ds, d2/ds2 (rad, rad, rad)
   };
   Kinematics calcKinematics(double q0, double q1) const;
+  /// theta4(s) and its first two derivatives at the state's s, from the
+  /// kinematics the State holds (the ones its Stage::Position used).
+  SimTK::Vec3 getUpperArmAngle(const SimTK::State& s) const { return atState(s).theta4; }
 
   /// Allocates the kinematics cache entry (Simbody calls it).
   void realizeTopology(SimTK::State& s) const override;
@@ -193,6 +197,7 @@ std::vector<ArmPlanesImpl::Row> armPlaneRows(const DoubleWishboneParams& p, cons
 struct ReducedWishboneCorner {
   SimTK::MobilizedBody::Pin lower_arm;   ///< its angle tied to s
   SimTK::MobilizedBody::Custom knuckle;  ///< q = [s, delta]
+  const ReducedKnuckleMobilizer* knuckle_mobilizer = nullptr;  ///< its implementation (owned by the matter subsystem)
   SimTK::MobilizedBody::Pin upper_arm;   ///< its angle tied to theta4(s)
   SimTK::MobilizedBody::Pin wheel;
   SimTK::Force::TwoPointLinearSpring spring;

@@ -210,7 +210,8 @@ std::vector<ArmPlanesImpl::Row> ReducedDoubleWishboneSuspension::getArmRows(int 
 }
 
 bool ReducedDoubleWishboneSuspension::getDenseArm(int side, ReducedDenseRows::Arm* arm) const {
-  *arm = {reduced_[side].lower_arm, reduced_[side].upper_arm, reduced_[side].knuckle, loops_[side].get()};
+  *arm = {reduced_[side].lower_arm, reduced_[side].upper_arm, reduced_[side].knuckle,
+          reduced_[side].knuckle_mobilizer};
   return true;
 }
 
