@@ -8,6 +8,8 @@
 // of it, so the two differ by at most twice the scene's stated accuracy
 // (triangle inequality). The bounds below are those statements, not fits.
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <functional>
 #include <map>
 #include <string>
@@ -201,6 +203,104 @@ TEST(Formulation, SolvedSteeringAccelerationsMeetTheLawsAndTheEquationsOfMotion)
   EXPECT_DOUBLE_EQ(front->calcAcceleration(s), car.denseRows()->solvedSteerAcceleration(s, 0));
   EXPECT_LE(car.denseRows()->lastLawSweeps(s), 2 + 2);  // nL + 2 for laws affine in x'' and delta''
   EXPECT_GE(car.denseRows()->lastLawSweeps(s), 2);
+}
+
+namespace {
+/// delta'' = gain a_y + c, a_y the chassis origin's Ground y acceleration
+/// (m/s^2; gain in rad/s^2 per m/s^2), or with `step` a jump: delta'' = -c
+/// for gain (a_y - threshold) >= 0, +c below (gain only its sign then).
+class ChassisAccelerationLaw : public SteeringLaw {
+ public:
+  ChassisAccelerationLaw(SimTK::MobilizedBodyIndex chassis, double gain, double c, bool step, double threshold = 0)
+      : SteeringLaw("chassis_acceleration"), chassis_(chassis), gain_(gain), c_(c), step_(step),
+        threshold_(threshold) {}
+
+ protected:
+  bool DoGetStationAccelerationInput(StationAccelerationInput* in) const override {
+    if (in) *in = {chassis_, SimTK::Vec3(0)};
+    return true;
+  }
+  double DoCalcAccelerationGiven(const SimTK::State&, const SimTK::Vec3& a) const override {
+    return step_ ? (gain_ * (a[1] - threshold_) >= 0 ? -c_ : c_) : gain_ * a[1] + c_;
+  }
+  double DoCalcAcceleration(const SimTK::State&) const override { return 0; }
+
+ private:
+  SimTK::MobilizedBodyIndex chassis_;
+  double gain_, c_;
+  bool step_;
+  double threshold_;
+};
+
+/// delta'' = 0.
+class ZeroLaw : public SteeringLaw {
+ public:
+  ZeroLaw() : SteeringLaw("zero") {}
+
+ protected:
+  double DoCalcAcceleration(const SimTK::State&) const override { return 0; }
+};
+
+/// ch8's scene without its controllers, the front steering driven by `law`
+/// and the rear held (delta'' = 0), in its initial state turned so that the
+/// chassis accelerates sideways.
+struct LawScene {
+  BuiltScene built;
+  SimTK::State state;
+};
+LawScene sceneWithFrontLaw(double gain, double c, bool step, double threshold = 0) {
+  const std::string file = (std::filesystem::temp_directory_path() / "vdyn_test_front_law.json").string();
+  {
+    std::ofstream out(file);
+    out << R"({"based_on": "scenes/ch8_maneuvers.json", "plugins": [{"name": "path_control", "remove": true},)"
+        << R"( {"name": "rear_control", "remove": true}], "outputs": ["chassis.y_m"]})";
+  }
+  LawScene r{SceneDescription::fromFile(file, standardRegistry()).build(), {}};
+  std::filesystem::remove(file);
+  const Scene& scene = r.built.scene();
+  const SimTK::MobilizedBodyIndex chassis = scene.getBody("chassis").getMobilizedBodyIndex();
+  scene.findPlugin<SteeringPlugin>("front_steer")
+      ->setAccelerationLaw(std::make_shared<ChassisAccelerationLaw>(chassis, gain, c, step, threshold));
+  scene.findPlugin<SteeringPlugin>("rear_steer")->setAccelerationLaw(std::make_shared<ZeroLaw>());
+  r.state = r.built.makeInitialState();
+  scene.findPlugin<SteeringPlugin>("front_steer")->getSteerBody().setOneU(r.state, 0, 0.2);
+  return r;
+}
+}  // namespace
+
+// The laws' sweeps, accelerated, on laws plain sweeps could not settle. A law
+// delta'' = g a_y + c on the chassis's lateral acceleration a_y, itself
+// affine in delta'' (a_y = a0 + k delta''): with |g k| > 1 plain sweeps
+// diverge, and the accelerated ones start sweep nL + 2 = 3 at the fixed point
+// (delta'' = (g a0 + c) / (1 - g k)), which Simbody's realized accelerations
+// then meet. A law with a jump (delta'' = -c where k (a_y - a0) >= 0, +c
+// below: each value moves a_y to the other side) has no fixed point: the
+// solve stops after 50 sweeps with an Error naming the time and the change.
+TEST(Formulation, AcceleratedLawSweepsSettleAnExpansiveLoopAndStopOnOneWithoutFixedPoint) {
+  // a0 and k from two solves with gain 0: a_y at delta'' = 0 and per rad/s^2 of delta''.
+  auto ay = [](LawScene& r) {
+    const Scene& scene = r.built.scene();
+    scene.getSystem().realize(r.state, SimTK::Stage::Acceleration);
+    return scene.getBody("chassis").getBodyOriginAcceleration(r.state)[1];
+  };
+  LawScene z0 = sceneWithFrontLaw(0, 0, false), z1 = sceneWithFrontLaw(0, 1, false);
+  ASSERT_EQ(z0.built.vehicleAs<WheeledVehicle>().getFormulation().name, "dense");
+  const double a0 = ay(z0), k = ay(z1) - a0;
+  ASSERT_GT(std::abs(k), 1e-6) << "delta'' must move a_y";
+  const double g = -4 / k, c = 0.3;  // g k = -4: plain sweeps grow the error fourfold each
+  LawScene r = sceneWithFrontLaw(g, c, false);
+  const double a = ay(r);
+  const SteeringPlugin& front = *r.built.scene().findPlugin<SteeringPlugin>("front_steer");
+  const double udot = front.getSteerBody().getOneUDot(r.state, SimTK::MobilizerUIndex(0));
+  const WheeledVehicle& car = r.built.vehicleAs<WheeledVehicle>();
+  EXPECT_NEAR(udot, (g * a0 + c) / (1 - g * k), 1e-9 * (1 + std::abs(udot)));
+  EXPECT_NEAR(udot, g * a + c, 1e-7);  // the law at Simbody's realized acceleration
+  EXPECT_LE(car.denseRows()->lastLawSweeps(r.state), 3);
+
+  LawScene j = sceneWithFrontLaw(k, 1.0, true, a0);
+  const std::string err = test::errorOf([&] { ay(j); });
+  EXPECT_NE(err.find("reduced dense dynamics: the steering laws' delta'' did not settle in 50 sweeps at t = 0 s"),
+            std::string::npos) << err;
 }
 
 // The same scene's dense rows in its initial state: G M^-1 G^T from the

@@ -507,10 +507,10 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
   // g that makes their combined residual g - x least (Anderson acceleration
   // with up to nL differences kept (8 at most): for laws affine in x'' and in the other
   // laws' delta'', as the path and rear-steer laws are, the start of sweep
-  // nL + 2 is the fixed point to rounding, and that sweep confirms it). A
-  // sweep whose residual grew starts the history afresh (a plain sweep). The
-  // result is the last sweep's g, accepted as before when it moved less than
-  // 1e-10 (1 + |delta''|) from its start.
+  // nL + 2 is the fixed point to rounding, and that sweep confirms it, whether
+  // or not plain sweeps would contract). The result is the last sweep's g,
+  // accepted as before when it moved less than 1e-10 (1 + |delta''|) from its
+  // start; laws that do not settle end in an Error after 50 sweeps.
   struct Solving {
     Work& w;
     ~Solving() { w.solving = false; }
@@ -527,14 +527,13 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
   constexpr double kTolerance = 1e-10;  // relative to 1 + |x|, rad/s^2: above the laws' rounding (1e-12 seen)
   const int memory = std::min(nL, 8);  // differences kept
   int sweeps = 0, kept = 0;
-  double change = 0, residual = 0, residualPrev = HUGE_VAL;
+  double change = 0;
   for (;;) {
     if (++sweeps > kMaxSweeps)
       throw Error("reduced dense dynamics: the steering laws' delta'' did not settle in " + std::to_string(kMaxSweeps) +
                   " sweeps at t = " + formatValue(s.getTime()) + " s (last relative change " + formatValue(change) + ")");
     w.x = w.start;
     change = 0;
-    residual = 0;
     for (int k = 0; k < nL; ++k) {
       const SteeringLaw* law = laws_[k].plugin->getAccelerationLaw();
       double v;
@@ -547,36 +546,28 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
       }
       w.f[k] = v - w.start[k];
       change = std::max(change, std::abs(w.f[k]) / (1 + std::abs(v)));
-      residual = std::max(residual, std::abs(w.f[k]));
       w.x[k] = v;
     }
     if (change <= kTolerance) break;
     // The next start: g - dG gamma, gamma the least-squares solution of
     // dF gamma = f over the kept differences (normal equations; a history
-    // whose equations are singular, or a sweep whose residual grew, is dropped).
+    // whose equations are singular is dropped).
     if (sweeps > 1) {
-      if (!(residual < residualPrev)) {
-        kept = 0;
-      } else {
-        if (kept == memory) {  // the oldest difference out
-          w.dG.erase(w.dG.begin(), w.dG.begin() + nL);
-          w.dF.erase(w.dF.begin(), w.dF.begin() + nL);
-          --kept;
-        }
-        w.dG.resize(std::size_t(kept + 1) * nL);
-        w.dF.resize(std::size_t(kept + 1) * nL);
-        for (int k = 0; k < nL; ++k) {
-          w.dG[std::size_t(kept) * nL + k] = w.x[k] - w.gPrev[k];
-          w.dF[std::size_t(kept) * nL + k] = w.f[k] - w.fPrev[k];
-        }
-        ++kept;
+      if (kept == memory) {  // the oldest difference out
+        w.dG.erase(w.dG.begin(), w.dG.begin() + nL);
+        w.dF.erase(w.dF.begin(), w.dF.begin() + nL);
+        --kept;
       }
-      w.dG.resize(std::size_t(kept) * nL);
-      w.dF.resize(std::size_t(kept) * nL);
+      w.dG.resize(std::size_t(kept + 1) * nL);
+      w.dF.resize(std::size_t(kept + 1) * nL);
+      for (int k = 0; k < nL; ++k) {
+        w.dG[std::size_t(kept) * nL + k] = w.x[k] - w.gPrev[k];
+        w.dF[std::size_t(kept) * nL + k] = w.f[k] - w.fPrev[k];
+      }
+      ++kept;
     }
     w.gPrev = w.x;
     w.fPrev = w.f;
-    residualPrev = residual;
     w.start = w.x;
     if (kept > 0) {
       double M[8][9];  // [dF^T dF | dF^T f]
