@@ -3,6 +3,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Dense>
+
 #include "vdyn/core/error.h"
 #include "vdyn/speed/speed_hold.h"
 
@@ -550,8 +552,7 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
     }
     if (change <= kTolerance) break;
     // The next start: g - dG gamma, gamma the least-squares solution of
-    // dF gamma = f over the kept differences (normal equations; a history
-    // whose equations are singular is dropped).
+    // dF gamma = f over the kept differences (w.dF, w.dG: nL x kept, by column).
     if (sweeps > 1) {
       if (kept == memory) {  // the oldest difference out
         w.dG.erase(w.dG.begin(), w.dG.begin() + nL);
@@ -570,53 +571,23 @@ void ReducedDenseRows::solveLaws(const SimTK::State& s, Work& w) const {
     w.fPrev = w.f;
     w.start = w.x;
     if (kept > 0) {
-      double M[8][9];  // [dF^T dF | dF^T f]
-      const int q = kept;
-      const double* dF = w.dF.data();
-      const double* dG = w.dG.data();
-      for (int i = 0; i < q; ++i) {
-        for (int j = 0; j < q; ++j) {
-          double a = 0;
-          for (int k = 0; k < nL; ++k) a += dF[std::size_t(i) * nL + k] * dF[std::size_t(j) * nL + k];
-          M[i][j] = a;
-        }
-        double b = 0;
-        for (int k = 0; k < nL; ++k) b += dF[std::size_t(i) * nL + k] * w.f[k];
-        M[i][q] = b;
-      }
-      // Gaussian elimination with partial pivoting; a pivot below 1e-12 of
-      // the largest diagonal entry: singular (the history is dropped).
-      double scale = 0;
-      for (int i = 0; i < q; ++i) scale = std::max(scale, M[i][i]);
-      bool singular = !(scale > 0);
-      for (int col = 0; col < q && !singular; ++col) {
-        int piv = col;
-        for (int i = col + 1; i < q; ++i)
-          if (std::abs(M[i][col]) > std::abs(M[piv][col])) piv = i;
-        if (!(std::abs(M[piv][col]) > 1e-12 * scale)) {
-          singular = true;
-          break;
-        }
-        if (piv != col)
-          for (int j = col; j <= q; ++j) std::swap(M[col][j], M[piv][j]);
-        for (int i = col + 1; i < q; ++i) {
-          const double r = M[i][col] / M[col][col];
-          for (int j = col; j <= q; ++j) M[i][j] -= r * M[col][j];
-        }
-      }
-      if (singular) {
+      // Eigen's full-pivot LU on the normal equations (at most 8 x 8: no heap);
+      // a rank below kept (pivots under 1e-12 of the largest) drops the history.
+      using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 8, 8>;
+      const Eigen::Map<const Eigen::MatrixXd> dF(w.dF.data(), nL, kept), dG(w.dG.data(), nL, kept);
+      const Eigen::Map<const Eigen::VectorXd> f(w.f.data(), nL);
+      const Small M = dF.transpose() * dF;
+      Eigen::FullPivLU<Small> lu(M);
+      lu.setThreshold(1e-12);
+      if (lu.rank() < kept) {
         kept = 0;
         w.dG.clear();
         w.dF.clear();
       } else {
-        double gamma[8];
-        for (int i = q - 1; i >= 0; --i) {
-          double v = M[i][q];
-          for (int j = i + 1; j < q; ++j) v -= M[i][j] * gamma[j];
-          gamma[i] = v / M[i][i];
-        }
-        for (int j = 0; j < q; ++j)
-          for (int k = 0; k < nL; ++k) w.start[k] -= gamma[j] * dG[std::size_t(j) * nL + k];
+        using SmallVector = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+        const SmallVector b = dF.transpose() * f;
+        const SmallVector gamma = lu.solve(b);
+        Eigen::Map<Eigen::VectorXd>(w.start.data(), nL).noalias() -= dG * gamma;
       }
     }
   }

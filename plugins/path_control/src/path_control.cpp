@@ -459,9 +459,8 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   // Outputs of what x'' moves (e3, e4, x'' itself) need Stage::Acceleration
   // with the "solved" estimate; the others are read with x'' = 0 there.
   const bool solved = p_.acceleration_estimate == "solved";
-  // Only feedforward_target_rad's evaluation solves for delta_ss (withTarget).
-  auto add = [&](const std::string& key, const std::string& unit, bool readsXdd, auto f) {
-    const bool target = key == "feedforward_target_rad";
+  // `target`: the output reads delta_ss (only feedforward_target_rad's evaluation solves for it).
+  auto add = [&](const std::string& key, const std::string& unit, bool readsXdd, auto f, bool target = false) {
     if (solved && !readsXdd)
       scene.addOutput({name() + "." + key, unit, SimTK::Stage::Velocity, [law, f, target](const SimTK::State& s) {
                          return f(law->calcEvaluationGiven(s, Vec2(0, 0), target));
@@ -475,7 +474,8 @@ void PathControlPlugin::DoAddTo(Scene& scene) {
   add("e3_m", "m", true, [](const PathControlEvaluation& e) { return e.ahead.position_m; });
   add("e4", "1", true, [](const PathControlEvaluation& e) { return e.ahead.slope; });
   add("feedforward_rad", "rad", false, [](const PathControlEvaluation& e) { return e.feedforward_rad; });
-  add("feedforward_target_rad", "rad", false, [](const PathControlEvaluation& e) { return e.feedforward_target_rad; });
+  add("feedforward_target_rad", "rad", false, [](const PathControlEvaluation& e) { return e.feedforward_target_rad; },
+      true);
   add("reference_yaw_rate_rad_s", "rad/s", false,
       [](const PathControlEvaluation& e) { return e.reference_yaw_rate_rad_s; });
   // The estimated (or solved) acceleration's component normal to the velocity (+ left).
