@@ -493,18 +493,27 @@ TEST(Formulation, AutoIntegratorGoesOnWithCpodesWhereRkMersonIsHeldByStability) 
   EXPECT_LE(extra / (n + 1), 3) << "checks at steps 25, 100 and 400 of about 520";
 }
 
-// Where CPodes, once switched to, costs more than RK Merson did (the chapter 8
-// lane change on the 4WS car: the check finds a damped mode near -217 1/s at
-// RK Merson's limit, but at 1e-6 CPodes's steps stay short: about four times
-// RK Merson's evaluations per simulated second, its first Jacobian included),
-// "auto" goes back to RK Merson for good once CPodes has spent more than RK
-// Merson's evaluation rate and the allowance (one Jacobian and 50) give, so
-// the run costs at most the check, the allowance and RK Merson's restart more
-// than RK Merson throughout (measured 1.09x) and ends on the same path (within
-// the integrator's accuracy).
+// Where CPodes, once switched to, costs more than RK Merson did, "auto" goes
+// back to RK Merson for good once CPodes has spent more than RK Merson's
+// evaluation rate and the allowance (one Jacobian and 50) give, so the run
+// costs at most the check, the allowance and RK Merson's restart more than RK
+// Merson throughout, and ends where RK Merson does (within the accuracy).
+// The case: the peer scene with its front steer stepped by +-0.01 rad in 2 ms
+// every 0.2 s from 0.4 s (22 steps): between the steps RK Merson is held by
+// the wheel-spin mode and the check switches; at each step CPodes restarts
+// its order and step. Measured: back at t = 1.4 s, 1.02x RK Merson's
+// evaluations, yaw rates 2.6e-7 apart (relative).
 TEST(Formulation, AutoIntegratorGoesBackToRkMersonWhereCpodesCostsMore) {
+  const std::string peer = std::string(VDYN_TEST_DATA_DIR) + "/fiala_turn.json";
+  Json steps = Json::array();
+  for (int i = 0; i < 22; ++i)
+    steps.push_back({{"start_time_s", 0.4 + 0.2 * i}, {"duration_s", 0.002}, {"change_rad", i % 2 == 0 ? 0.01 : -0.01}});
+  const Json command = {{"type", "steps"}, {"initial_rad", 0.0698131700797732}, {"steps", steps}};
   auto run = [&](const std::string& method) {
-    return runFormulation("scenes/ch8_maneuvers.json", "", {{"analysis.integrator.method", method}});
+    return runFormulation(peer, "dense",
+                          {{"analysis.integrator.method", method},
+                           {"analysis.integrator.accuracy", 1e-6},
+                           {"plugins.front_steer.command", command}});
   };
   const FormulationRun au = run("auto"), rk = run("rk_merson");
   const Json& ra = au.result.summary["run"];
@@ -513,6 +522,28 @@ TEST(Formulation, AutoIntegratorGoesBackToRkMersonWhereCpodesCostsMore) {
   EXPECT_NE(choice.find("; back to rk_merson at t = "), std::string::npos) << choice;
   const long nAuto = ra["realizations"].get<long>(), nRk = rk.result.summary["run"]["realizations"].get<long>();
   EXPECT_LT(nAuto, 1.15 * nRk) << "auto " << nAuto << ", rk_merson " << nRk;
+  const char* k = "chassis.yaw_rate_rad_s";
+  const double r0 = rk.result.summary["final"][k].get<double>();
+  EXPECT_NEAR(au.result.summary["final"][k].get<double>(), r0, 1e-6 * std::abs(r0));
+}
+
+// The chapter 8 lane change on the 4WS car (path control and the rear-steer
+// law solved in the dense rows): the check finds a damped mode near -217 1/s
+// at RK Merson's limit and switches; CPodes, with the Jacobian's columns
+// differenced at 1e-7 max(|y_j|, 1e-2) (CpodesStepper), steps past it with
+// about half RK Merson's evaluations (measured 1698 against 3090) and ends on
+// the same path within the accuracy (6e-9 m measured).
+TEST(Formulation, AutoIntegratorStaysOnCpodesThroughTheChapter8LaneChange) {
+  auto run = [&](const std::string& method) {
+    return runFormulation("scenes/ch8_maneuvers.json", "", {{"analysis.integrator.method", method}});
+  };
+  const FormulationRun au = run("auto"), rk = run("rk_merson");
+  const Json& ra = au.result.summary["run"];
+  const std::string choice = ra["integrator_choice"].get<std::string>();
+  EXPECT_EQ(choice.rfind("rk_merson, then cpodes from t = ", 0), 0u) << choice;
+  EXPECT_EQ(choice.find("back to rk_merson"), std::string::npos) << choice;
+  const long nAuto = ra["realizations"].get<long>(), nRk = rk.result.summary["run"]["realizations"].get<long>();
+  EXPECT_LT(nAuto, 0.7 * nRk) << "auto " << nAuto << ", rk_merson " << nRk;
   for (const char* k : {"chassis.y_m", "path_control.e1_m"})
     EXPECT_NEAR(au.result.summary["final"][k].get<double>(), rk.result.summary["final"][k].get<double>(), 1e-6) << k;
 }

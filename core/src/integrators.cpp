@@ -64,12 +64,14 @@ IntegratorSettings IntegratorSettings::fromParams(const ParamReader& r) {
 std::unique_ptr<SimTK::Integrator> makeIntegrator(const SimTK::System& system,
                                                   const IntegratorSettings& s) {
   s.validate();
+  if (s.method == "cpodes")
+    throw Error("makeIntegrator: the integrator 'cpodes' is vdyn's CpodesStepper (vdyn/core/cpodes_stepper.h), "
+                "not a SimTK::Integrator");
   std::unique_ptr<SimTK::Integrator> integ;
   // "auto" starts as RK Merson; simulate() may go on with CPodes (stiffness.h).
   if (s.method == "rk_merson" || s.method == "auto") integ.reset(new SimTK::RungeKuttaMersonIntegrator(system));
   else if (s.method == "rk3") integ.reset(new SimTK::RungeKutta3Integrator(system));
   else if (s.method == "rk_feldberg") integ.reset(new SimTK::RungeKuttaFeldbergIntegrator(system));
-  else if (s.method == "cpodes") integ.reset(new SimTK::CPodesIntegrator(system, SimTK::CPodes::BDF, SimTK::CPodes::Newton));
   else if (s.method == "verlet") integ.reset(new SimTK::VerletIntegrator(system));
   else if (s.method == "semi_explicit_euler2") integ.reset(new SimTK::SemiExplicitEuler2Integrator(system));
   assert(integ);

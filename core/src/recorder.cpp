@@ -57,6 +57,18 @@ void Recorder::recordInterpolated(double t, double t0, const SimTK::Vector& y0, 
   work_.setTime(t);
   SimTK::Vector& y = work_.updY();
   for (int i = 0; i < y.size(); ++i) y[i] = cy0 * y0[i] + cy1 * y1[i] + cf0 * f0[i] + cf1 * f1[i];
+  recordWorkspace();
+}
+
+void Recorder::recordAt(double t, const SimTK::Vector& y, const SimTK::State& like) {
+  syncWorkspace(like);
+  work_.setTime(t);
+  work_.updY() = y;
+  recordWorkspace();
+}
+
+void Recorder::recordWorkspace() {
+  const double t = work_.getTime();
   const SimTK::System& system = scene_.getSystem();
   system.realize(work_, SimTK::Stage::Time);
   system.prescribeQ(work_);

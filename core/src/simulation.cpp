@@ -1,5 +1,6 @@
 #include <algorithm>
 #include "vdyn/core/simulation.h"
+#include "vdyn/core/cpodes_stepper.h"
 #include "vdyn/core/interrupt.h"
 #include "vdyn/core/stiffness.h"
 
@@ -63,6 +64,67 @@ double positionConstraintError(const SimTK::State& state) {
   return qerr.size() ? qerr.normInf() : 0.0;
 }
 
+namespace {
+
+// The run's integrator: one of Simbody's (SimTK::Integrator, every method but
+// cpodes) or CPodes as vdyn drives it (CpodesStepper), behind the calls the
+// loop below makes. Both return after every internal step; reports are
+// interpolated, never stepped to.
+class Stepping {
+ public:
+  Stepping(const SimTK::System& system, const IntegratorSettings& settings) {
+    if (settings.method == "cpodes") {
+      cpodes_.reset(new CpodesStepper(system, settings));
+    } else {
+      integ_ = makeIntegrator(system, settings);
+      integ_->setReturnEveryInternalStep(true);
+    }
+  }
+  /// CPodes, or nullptr for Simbody's integrators.
+  CpodesStepper* cpodes() const { return cpodes_.get(); }
+  /// `jacobian`: df/dy at `state`, for CPodes's first Newton matrix (others ignore it).
+  void initialize(const SimTK::State& state, const Eigen::MatrixXd* jacobian = nullptr) {
+    if (cpodes_) cpodes_->initialize(state, jacobian);
+    else integ_->initialize(state);
+  }
+  void setFinalTime(double t) {
+    finalTime_ = t;
+    if (cpodes_) cpodes_->setFinalTime(t);
+    else integ_->setFinalTime(t);
+  }
+  SimTK::Integrator::SuccessfulStepStatus step() {
+    if (!cpodes_) return integ_->stepTo(finalTime_);
+    return cpodes_->step() ? SimTK::Integrator::EndOfSimulation : SimTK::Integrator::TimeHasAdvanced;
+  }
+  /// The last step's end (Simbody's: realized through Acceleration; CPodes's: through Velocity).
+  const SimTK::State& getState() const { return cpodes_ ? cpodes_->getState() : integ_->getState(); }
+  /// Simbody's advanced state (the step's end, where getState() may be interpolated); CPodes's step end.
+  const SimTK::State& getAdvancedState() const { return cpodes_ ? cpodes_->getState() : integ_->getAdvancedState(); }
+  double getTime() const { return cpodes_ ? cpodes_->getTime() : integ_->getTime(); }
+  double getPreviousStepSizeTaken() const {
+    return cpodes_ ? cpodes_->getPreviousStepSizeTaken() : integ_->getPreviousStepSizeTaken();
+  }
+  long getNumStepsTaken() const { return cpodes_ ? cpodes_->getNumStepsTaken() : integ_->getNumStepsTaken(); }
+  long getNumStepsAttempted() const {
+    return cpodes_ ? cpodes_->getNumStepsAttempted() : integ_->getNumStepsAttempted();
+  }
+  long getNumRealizations() const { return cpodes_ ? cpodes_->getNumRealizations() : integ_->getNumRealizations(); }
+  long getNumProjections() const { return cpodes_ ? cpodes_->getNumProjections() : integ_->getNumProjections(); }
+  /// Throws Error if Simbody's integrator stopped before the final time.
+  void throwIfStoppedEarly(const std::string& method) const {
+    if (integ_ && integ_->isSimulationOver() && integ_->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
+      throw Error("simulate: " + method + " stopped early at t = " + formatValue(integ_->getTime()) + " s (" +
+                  SimTK::Integrator::getTerminationReasonString(integ_->getTerminationReason()) + ")");
+  }
+
+ private:
+  std::unique_ptr<SimTK::Integrator> integ_;
+  std::unique_ptr<CpodesStepper> cpodes_;
+  double finalTime_ = SimTK::Infinity;
+};
+
+}  // namespace
+
 RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSettings& s,
                     Recorder* recorder, const std::function<void(const SimTK::State&)>& afterStep,
                     RunSummary* partial) {
@@ -106,8 +168,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   double segEnd = ends[0];
   long doneSteps = 0, doneAttempts = 0, doneRealizations = 0, doneProjections = 0;  // of finished segments
 
-  auto integ = makeIntegrator(scene.getSystem(), phase);
-  integ->setReturnEveryInternalStep(true);
+  auto integ = std::make_unique<Stepping>(scene.getSystem(), phase);
   integ->setFinalTime(segEnd);
   try {
     integ->initialize(state);
@@ -137,18 +198,17 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     auto nextReport = [&] { return std::min(s.t_end_s, t0 + k * s.report_interval_s); };
     if (reporting) recorder->record(integ->getState());
     double lastReported = t0;
-    // Reporting without State copies: the Runge-Kutta family (Simbody's
-    // AbstractIntegratorRep) steps to t_end and the recorder evaluates the
-    // integrator's own cubic Hermite interpolant of each step (previous Y and
-    // YDot kept here, two vectors) in one reused workspace state, unprojected
-    // (the samples read positions and velocities, no constraint needs them
-    // exact). CPodes interpolates with its own polynomial: it stops at report
-    // times and its interpolated states are not projected either.
-    bool ownInterpolation = reporting && phase.method != "cpodes";
-    if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
-    SimTK::Vector yPrev, ydotPrev;
+    // Reporting without State copies or steps to report times: the
+    // integrator steps to t_end and the recorder evaluates, in one reused
+    // workspace state and unprojected (the samples read positions and
+    // velocities, no constraint needs them exact), the interpolant of each
+    // step that passed report times: for Simbody's Runge-Kutta family
+    // (AbstractIntegratorRep) its own cubic Hermite interpolant (previous Y
+    // and YDot kept here, two vectors), for CPodes its own polynomial.
+    const bool ownInterpolation = reporting;
+    SimTK::Vector yPrev, ydotPrev, yAt;
     double tPrev = t0;
-    if (ownInterpolation) {
+    if (ownInterpolation && !integ->cpodes()) {
       const SimTK::State& s0 = integ->getState();
       scene.getSystem().realize(s0, SimTK::Stage::Acceleration);
       yPrev = s0.getY();
@@ -158,22 +218,30 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     auto sampleStep = [&](const SimTK::State& adv) {
       const double t1 = adv.getTime();
       if (!(t1 > tPrev)) return;
+      const CpodesStepper* cp = integ->cpodes();
       // The next step's first stage (the integrator then finds it done and does
       // not count it): counted here, so `realizations` stays the number of
       // forward-dynamics evaluations.
-      if (adv.getSystemStage() < SimTK::Stage::Acceleration) {
+      if (!cp && adv.getSystemStage() < SimTK::Stage::Acceleration) {
         scene.getSystem().realize(adv, SimTK::Stage::Acceleration);
         ++ownRealizations;
       }
       const double tEndTol = 1e-12 * std::max(1.0, std::abs(s.t_end_s));
       while (lastReported < s.t_end_s - tEndTol && nextReport() <= t1 + tEndTol) {
         const double tr = std::min(nextReport(), t1);
-        recorder->recordInterpolated(tr, tPrev, yPrev, ydotPrev, adv);
+        if (cp) {
+          cp->interpolate(tr, yAt);
+          recorder->recordAt(tr, yAt, adv);
+        } else {
+          recorder->recordInterpolated(tr, tPrev, yPrev, ydotPrev, adv);
+        }
         lastReported = tr;
         ++k;
       }
-      yPrev = adv.getY();
-      ydotPrev = adv.getYDot();
+      if (!cp) {
+        yPrev = adv.getY();
+        ydotPrev = adv.getYDot();
+      }
       tPrev = t1;
     };
 
@@ -202,6 +270,9 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     double recent[kRecent] = {0};
     bool cpodesTried = false;  // or a check failed: no more checks
     long rkSteps = 0, nextCheck = 25;
+    // The last check's Jacobian (at the state where CPodes starts if the
+    // check says held): CPodes's first Newton matrix is built from it.
+    Eigen::MatrixXd checkJacobian;
     double lastStable = 0;  // s, RK Merson's stability limit at the last check
     auto checkStiffness = [&](const SimTK::State& adv, double h) {
       recent[rkSteps % kRecent] = h;
@@ -215,8 +286,8 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       std::complex<double> lambda;
       double hStable = 0;
       try {
-        hStable = calcRkMersonStabilityLimit(
-            calcEigenvalues(calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations)), &lambda);
+        checkJacobian = calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations);
+        hStable = calcRkMersonStabilityLimit(calcEigenvalues(checkJacobian), &lambda);
       } catch (const std::exception& e) {
         // A diagnostic does not end a run: RK Merson goes on, unchecked, and the summary says why.
         char at[40];
@@ -257,7 +328,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       if (!(double(integ->getNumRealizations()) > allowed)) return false;
       char buf[240];
       std::snprintf(buf, sizeof buf,
-                    "; back to rk_merson at t = %.6g s: cpodes took %d evaluations for %.3g s, where rk_merson's "
+                    "; back to rk_merson at t = %.6g s: cpodes took %ld evaluations for %.3g s, where rk_merson's "
                     "rate (%.4g / s) and the allowance give %.0f",
                     adv.getTime(), integ->getNumRealizations(), adv.getTime() - tSwitch, rkRate, allowed);
       sum.integrator_choice += buf;
@@ -274,13 +345,15 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     // Starts the integrator at `st` (its initialization projects and realizes
     // the first stage), and the own interpolation there; `what` and `why` go
     // into the message if it fails.
-    auto startAt = [&](const SimTK::State& st, const std::string& what, const std::string& why) {
+    auto startAt = [&](const SimTK::State& st, const std::string& what, const std::string& why,
+                       const Eigen::MatrixXd* jacobian = nullptr) {
       try {
-        integ->initialize(st);
+        integ->initialize(st, jacobian);
       } catch (const std::exception& e) {
         throw Error("simulate: " + what + " at t = " + formatValue(st.getTime()) + " s" + why + " failed: " + e.what());
       }
-      if (ownInterpolation) {
+      tPrev = integ->getState().getTime();
+      if (ownInterpolation && !integ->cpodes()) {
         const SimTK::State& s1 = integ->getState();
         scene.getSystem().realize(s1, SimTK::Stage::Acceleration);
         yPrev = s1.getY();
@@ -298,17 +371,14 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         cpodesAllowance = long(st.getNY()) + 1 + 50;
       }
       phase.method = method;
-      integ = makeIntegrator(scene.getSystem(), phase);
-      integ->setReturnEveryInternalStep(true);
+      integ = std::make_unique<Stepping>(scene.getSystem(), phase);
       integ->setFinalTime(segEnd);
-      ownInterpolation = reporting && method != "cpodes";
-      if (reporting && !ownInterpolation) integ->setProjectInterpolatedStates(false);
-      startAt(st, "integrator auto: starting " + method, "");
+      startAt(st, "integrator auto: starting " + method, "", method == "cpodes" ? &checkJacobian : nullptr);
     };
     for (;;) {
       SimTK::Integrator::SuccessfulStepStatus status;
       try {
-        status = integ->stepTo(reporting && !ownInterpolation ? std::min(nextReport(), segEnd) : segEnd);
+        status = integ->step();
       } catch (const std::exception& e) {
         // The last accepted state says where the run broke down (the integrator's
         // message says only that it could not step on).
@@ -334,8 +404,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         if (smallSteps >= s.min_step_count)
           throw stopped("step size collapsed: " + std::to_string(smallSteps) + " steps in a row shorter than min_step_s = " +
                         formatValue(s.min_step_s) + " s");
-        if (autoMethod && adv.getTime() < segEnd - 1e-9 * std::max(1.0, std::abs(segEnd)) &&
-            !(reporting && !ownInterpolation && nextReport() < adv.getTime())) {
+        if (autoMethod && adv.getTime() < segEnd - 1e-9 * std::max(1.0, std::abs(segEnd))) {
           std::string next;
           if (phase.method == "rk_merson" && !cpodesTried && checkStiffness(adv, h)) next = "cpodes";
           if (phase.method == "cpodes" && cpodesCostsMore(adv)) next = "rk_merson";
@@ -354,12 +423,6 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
             s.progress(adv, wall);
           }
         }
-      } else if (status == S::ReachedReportTime) {
-        if (reporting && !ownInterpolation) {
-          recorder->record(integ->getState());
-          lastReported = integ->getTime();
-          ++k;
-        }
       }
       const double segTol = 1e-12 * std::max(1.0, std::abs(segEnd));
       if (seg + 1 < ends.size() && (status == S::EndOfSimulation || integ->getTime() >= segEnd - segTol)) {
@@ -377,11 +440,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         break;
       }
     }
-    if (integ->isSimulationOver() &&
-        integ->getTerminationReason() != SimTK::Integrator::ReachedFinalTime)
-      throw Error("simulate: " + phase.method + " stopped early at t = " +
-                  formatValue(integ->getTime()) + " s (" +
-                  SimTK::Integrator::getTerminationReasonString(integ->getTerminationReason()) + ")");
+    integ->throwIfStoppedEarly(phase.method);
 
   } catch (...) {
     if (partial) {

@@ -10,22 +10,49 @@
 
 namespace vdyn {
 
+void calcStateDerivativeJacobianColumns(const SimTK::System& system, SimTK::State& work, const SimTK::Vector& f0,
+                                        double* const* columns, long* evaluations) {
+  const int nq = work.getNQ(), nu = work.getNU(), nz = work.getNZ();
+  system.realize(work, SimTK::Stage::Velocity);
+  // One column: y_j moved by dy (its Simbody stage's cache and those below
+  // stay valid), the accelerations realized, y_j put back.
+  auto column = [&](double& yj, int j) {
+    const double y0 = yj, dy = 1e-7 * std::max(std::abs(y0), 1e-2);
+    yj = y0 + dy;
+    system.realize(work, SimTK::Stage::Acceleration);
+    const SimTK::Vector& f = work.getYDot();
+    double* col = columns[j];
+    for (int i = 0; i < f.size(); ++i) col[i] = (f[i] - f0[i]) / dy;
+    // Restored through upd*, which invalidates the stages that depend on it.
+    return y0;
+  };
+  // z first (their change invalidates only Dynamics), then u (Velocity),
+  // then q (Position): each column recomputes only its own stages and up.
+  for (int k = 0; k < nz; ++k) {
+    const double z0 = column(work.updZ()[k], nq + nu + k);
+    work.updZ()[k] = z0;
+  }
+  for (int k = 0; k < nu; ++k) {
+    const double u0 = column(work.updU()[k], nq + k);
+    work.updU()[k] = u0;
+  }
+  for (int k = 0; k < nq; ++k) {
+    const double q0 = column(work.updQ()[k], k);
+    work.updQ()[k] = q0;
+  }
+  if (evaluations) *evaluations += nq + nu + nz;
+}
+
 Eigen::MatrixXd calcStateDerivativeJacobian(const SimTK::System& system, const SimTK::State& at, long* evaluations) {
   SimTK::State w = at;
   system.realize(w, SimTK::Stage::Acceleration);
   const int n = w.getNY();
-  const SimTK::Vector y0 = w.getY();
   const SimTK::Vector f0 = w.getYDot();
   Eigen::MatrixXd J(n, n);
-  for (int j = 0; j < n; ++j) {
-    const double dy = 1e-7 * std::max(std::abs(y0[j]), 1e-2);
-    w.updY() = y0;
-    w.updY()[j] += dy;
-    system.realize(w, SimTK::Stage::Acceleration);
-    const SimTK::Vector& f = w.getYDot();
-    for (int i = 0; i < n; ++i) J(i, j) = (f[i] - f0[i]) / dy;
-  }
-  if (evaluations) *evaluations += n + 1;
+  std::vector<double*> columns(n);
+  for (int j = 0; j < n; ++j) columns[j] = J.data() + std::ptrdiff_t(j) * n;
+  calcStateDerivativeJacobianColumns(system, w, f0, columns.data(), evaluations);
+  if (evaluations) ++*evaluations;
   return J;
 }
 

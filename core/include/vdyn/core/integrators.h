@@ -7,7 +7,8 @@
 //   rk_merson             Runge-Kutta-Merson, 4th order (Simbody's default)
 //   rk3                   Runge-Kutta 3rd order
 //   rk_feldberg           Runge-Kutta-Fehlberg 4(5)
-//   cpodes                CPodes variable-order BDF (implicit, for stiff scenes)
+//   cpodes                CPodes variable-order BDF (implicit, for stiff scenes),
+//                         driven by vdyn (vdyn/core/cpodes_stepper.h)
 //   verlet                velocity Verlet, 2nd order with error estimate
 //   semi_explicit_euler2  semi-explicit Euler with 2nd-order error estimate
 #include <memory>
@@ -47,7 +48,9 @@ const std::vector<std::string>& integratorNames();
 /// prints it once per process on stderr.
 std::string errorEstimateCaveat(const IntegratorSettings& settings);
 
-/// Creates the integrator; throws Error naming the method if it is unknown.
+/// Creates Simbody's integrator for `settings.method` (auto: RK Merson);
+/// throws Error naming the method if it is unknown, and for "cpodes", which
+/// simulate() runs through CpodesStepper (vdyn/core/cpodes_stepper.h).
 std::unique_ptr<SimTK::Integrator> makeIntegrator(const SimTK::System& system,
                                                   const IntegratorSettings& settings);
 

@@ -38,6 +38,11 @@ class Recorder {
   /// not projected. t0_s < t_s <= end.getTime().
   void recordInterpolated(double t_s, double t0_s, const SimTK::Vector& y0, const SimTK::Vector& ydot0,
                           const SimTK::State& end);
+  /// Evaluates the outputs at time `t_s` on y = `y` (an integrator's own
+  /// interpolant's value there, CpodesStepper::interpolate) with the
+  /// discrete part of `like` (a state of the same run), in the same reused
+  /// workspace as recordInterpolated; realized to the outputs' stage, not projected.
+  void recordAt(double t_s, const SimTK::Vector& y, const SimTK::State& like);
 
   const std::vector<std::string>& names() const { return names_; }
   std::size_t size() const { return time_.size(); }
@@ -56,6 +61,8 @@ class Recorder {
   SampleObserver observer_;
   /// The workspace's discrete part is that of `like` (copies it if not).
   void syncWorkspace(const SimTK::State& like);
+  /// Realizes the workspace (its t and y set) and records it.
+  void recordWorkspace();
   SimTK::State work_;
   bool haveWork_ = false;
   SimTK::Array_<SimTK::StageVersion> workVersions_;  ///< of the state work_ was copied from

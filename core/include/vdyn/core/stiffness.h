@@ -17,11 +17,21 @@ namespace vdyn {
 
 /// Jacobian df/dy of the system's state derivative at `at` (n x n,
 /// n = at.getNY(): q, u, z in Simbody's order), by forward differences of
-/// Simbody's realized derivatives, in a copy of `at` (which is not changed).
-/// Column j perturbs y_j by 1e-7 * max(|y_j|, 1e-2) (units of y_j).
-/// Adds the number of forward-dynamics evaluations (n + 1) to *evaluations.
+/// Simbody's realized derivatives, in a copy of `at` (which is not changed):
+/// calcStateDerivativeJacobianColumns. Adds the number of forward-dynamics
+/// evaluations (n + 1) to *evaluations.
 Eigen::MatrixXd calcStateDerivativeJacobian(const SimTK::System& system, const SimTK::State& at,
                                             long* evaluations = nullptr);
+
+/// The columns of df/dy at `work`'s t and y, where f(t, y) = `f0` (size n =
+/// work.getNY()), into columns[j][0 .. n-1], j = 0 .. n-1 (q, u, z in
+/// Simbody's order). Column j moves y_j by 1e-7 * max(|y_j|, 1e-2) (units of
+/// y_j) through State::updZ/updU/updQ and realizes the accelerations: a z
+/// column recomputes Dynamics and up, a u column Velocity and up, only a q
+/// column Position (z columns first, then u, then q). `work` ends at its
+/// original y. Adds n evaluations to *evaluations.
+void calcStateDerivativeJacobianColumns(const SimTK::System& system, SimTK::State& work, const SimTK::Vector& f0,
+                                        double* const* columns, long* evaluations = nullptr);
 
 /// Eigenvalues (1/s) of a square matrix; throws Error if an entry is not
 /// finite or the QR iterations do not converge.
