@@ -237,7 +237,6 @@ int CpodesStepper::jacobianCallback(int n, double t, void* y, void* fy, void* ja
                         std::to_string(J->M) + " x " + std::to_string(J->N) + ", n " + std::to_string(n);
     return SimTK::CPodes::UnrecoverableError;
   }
-  ++st.jacobians_;
   if (st.handed_) {
     // CPodes's first Newton matrix: asked at its first step's predicted y
     // (y0 + h y0'), answered with the Jacobian at y0, as CPodes itself
@@ -247,6 +246,7 @@ int CpodesStepper::jacobianCallback(int n, double t, void* y, void* fy, void* ja
       for (int i = 0; i < n; ++i) J->cols[j][i] = st.handedJacobian_(i, j);
     return SimTK::CPodes::Success;
   }
+  ++st.jacobians_;
   try {
     SimTK::State& w = st.work_;
     w.setTime(t);

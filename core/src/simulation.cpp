@@ -167,6 +167,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
   std::size_t seg = 0;
   double segEnd = ends[0];
   long doneSteps = 0, doneAttempts = 0, doneRealizations = 0, doneProjections = 0;  // of finished segments
+  long doneJacobians = 0;  // of finished segments, and the stiffness checks'.
 
   auto integ = std::make_unique<Stepping>(scene.getSystem(), phase);
   integ->setFinalTime(segEnd);
@@ -184,6 +185,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     r.attempts = int(doneAttempts + integ->getNumStepsAttempted());
     r.realizations = int(doneRealizations + integ->getNumRealizations() + ownRealizations);
     r.projections = int(doneProjections + integ->getNumProjections());
+    r.jacobians = int(doneJacobians + (integ->cpodes() ? integ->cpodes()->getNumJacobians() : 0));
     r.sim_time_s = simTime;
     r.wall_time_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   };
@@ -297,6 +299,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
         return false;
       }
       ownRealizations += int(evaluations);
+      ++doneJacobians;
       lastStable = hStable;
       // Held: the steps reach 0.8 of the limit, and the mode that sets it is
       // damped (damping ratio -Re/|lambda| >= 0.7): an oscillatory mode at the
@@ -341,6 +344,7 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
     auto closeCounts = [&] {
       doneSteps += integ->getNumStepsTaken(), doneAttempts += integ->getNumStepsAttempted();
       doneRealizations += integ->getNumRealizations(), doneProjections += integ->getNumProjections();
+      if (integ->cpodes()) doneJacobians += integ->cpodes()->getNumJacobians();
     };
     // Starts the integrator at `st` (its initialization projects and realizes
     // the first stage), and the own interpolation there; `what` and `why` go

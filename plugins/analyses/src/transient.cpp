@@ -98,6 +98,7 @@ Json summarizeTransient(const BuiltScene& built, const TransientSettings& settin
             {"attempts", run.attempts},
             {"realizations", run.realizations},
             {"projections", run.projections},
+            {"jacobians", run.jacobians},
             {"max_constraint_error", run.max_constraint_error},
             {"sim_time_s", run.sim_time_s},
             {"wall_time_s", run.wall_time_s},

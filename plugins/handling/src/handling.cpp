@@ -183,7 +183,7 @@ HandlingHistory runHandlingTransient(const HandlingVehicle& v, double U, double 
   RunSummary run, seg;
   auto add = [](RunSummary& to, const RunSummary& r) {
     to.steps += r.steps, to.attempts += r.attempts, to.realizations += r.realizations;
-    to.projections += r.projections, to.wall_time_s += r.wall_time_s, to.sim_time_s += r.sim_time_s;
+    to.projections += r.projections, to.jacobians += r.jacobians, to.wall_time_s += r.wall_time_s, to.sim_time_s += r.sim_time_s;
     to.max_constraint_error = std::max(to.max_constraint_error, r.max_constraint_error);
   };
   try {

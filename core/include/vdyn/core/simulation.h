@@ -54,6 +54,10 @@ struct RunSummary {
   int attempts = 0;           ///< attempted steps (accepted + rejected)
   int realizations = 0;       ///< full realizations of the system (cost driver)
   int projections = 0;        ///< constraint projections
+  /// Jacobians of y' = f(t, y) by differences (the integrator "auto"'s
+  /// stiffness checks, CPodes's Newton matrices), whose evaluations are
+  /// among the realizations (n or n + 1 each, n the number of states).
+  int jacobians = 0;
   /// Largest position-constraint error |qerr|_inf at the end of any step (m for
   /// loop closures, dimensionless for angle constraints).
   double max_constraint_error = 0;
