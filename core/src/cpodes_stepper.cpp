@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <utility>
 
 #include "vdyn/core/error.h"
 #include "vdyn/core/stiffness.h"
@@ -186,9 +187,24 @@ bool CpodesStepper::step() {
   double t = state_.getTime();
   const int flag = cpodes_->step(finalTime_, &t, y_, yp_, SimTK::CPodes::OneStepTstop);
   throwIfFailed(flag, "a step");
-  state_.setTime(t);
-  state_.updY() = y_;
-  system_.realize(state_, SimTK::Stage::Velocity);
+  // The step's last call was its projection (CPODES projects after the
+  // corrector, before the error test; an accepted step evaluates nothing
+  // after it): the work state then holds the step's end, realized through
+  // Velocity, and becomes it. CPodes's y is that state's y plus a correction
+  // it computed as (projected - y): equal to rounding, checked.
+  bool atEnd = work_.getTime() == t && work_.getSystemStage() >= SimTK::Stage::Velocity;
+  if (atEnd) {
+    const SimTK::Vector& w = work_.getY();
+    for (int i = 0; atEnd && i < y_.size(); ++i)
+      atEnd = std::abs(w[i] - y_[i]) <= 4 * SimTK::Eps * std::max(1.0, std::abs(y_[i]));
+  }
+  if (atEnd) {
+    std::swap(state_, work_);
+  } else {
+    state_.setTime(t);
+    state_.updY() = y_;
+    system_.realize(state_, SimTK::Stage::Velocity);
+  }
   const double tol = 1e-12 * std::max(1.0, std::abs(finalTime_));
   return flag == SimTK::CPodes::TstopReturn || t >= finalTime_ - tol;
 }

@@ -55,8 +55,8 @@ class CpodesStepper {
   /// time) if CPodes fails.
   bool step();
 
-  /// The state at the end of the last step: time, y, realized through
-  /// Velocity (not Acceleration).
+  /// The state at the end of the last step: time, y (CPodes's, or its
+  /// projection's to rounding), realized through Velocity (not Acceleration).
   const SimTK::State& getState() const { return state_; }
   /// y at time t in [end of the previous step, end of the last step], from
   /// CPodes's interpolating polynomial (not projected), into `y`.
