@@ -172,6 +172,22 @@ TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
   EXPECT_NEAR(calcRkMersonStabilityLimit({C(-2, 0), C(-400, 0), C(0, 0), C(5, 0)}, &limiting), lo / 400, 1e-9 * lo);
   EXPECT_EQ(limiting, C(-400, 0));
   EXPECT_EQ(calcRkMersonStabilityLimit({C(0, 0), C(3, 1)}), std::numeric_limits<double>::infinity());
+  // The left half-disk |z| <= 1 is stable (calcRkMersonStabilityLimit skips
+  // the eigenvalues that cannot set the limit by it): scanned on rays every
+  // 0.1 deg, radii every 0.005.
+  for (int a = 901; a < 2700; ++a)
+    for (int r = 1; r <= 200; ++r) {
+      const C z = std::polar(0.005 * r, a * M_PI / 1800);
+      ASSERT_LE(std::abs(calcRkMersonStabilityFunction(z)), 1.0) << z;
+    }
+  // A conjugate pair sets the limit: the first of the two as given is named;
+  // the small eigenvalues skipped change nothing.
+  const std::vector<C> pair = {C(-1, 0), C(-20, 112), C(-20, -112), C(-0.5, 0.1)};
+  const double hPair = calcRkMersonStabilityLimit(pair, &limiting);
+  EXPECT_EQ(limiting, C(-20, 112));
+  EXPECT_EQ(calcRkMersonStabilityLimit({C(-20, -112), C(-20, 112)}, &limiting), hPair);
+  EXPECT_EQ(limiting, C(-20, -112));
+  EXPECT_EQ(calcRkMersonStabilityLimit({C(-20, 112)}), hPair);
 
   const double m = 2.0, k = 800.0, c = 90.0;  // kg, N/m, N s/m: overdamped
   SimTK::MultibodySystem system;

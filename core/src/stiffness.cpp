@@ -81,9 +81,21 @@ std::complex<double> calcRkMersonStabilityFunction(std::complex<double> z) {
 double calcRkMersonStabilityLimit(const std::vector<std::complex<double>>& eigenvalues,
                                   std::complex<double>* limiting) {
   double hMin = std::numeric_limits<double>::infinity();
-  for (const auto& lambda : eigenvalues) {
+  // Largest |lambda| first: R is stable on the left half-disk |z| <= 1
+  // (kStableRadius, tests/test_core.cpp scans it), so an eigenvalue with
+  // 1 / |lambda| above the smallest limit so far cannot set a smaller one,
+  // nor can any after it.
+  constexpr double kStableRadius = 1.0;
+  std::vector<std::size_t> order(eigenvalues.size());
+  for (std::size_t i = 0; i < order.size(); ++i) order[i] = i;
+  std::sort(order.begin(), order.end(),
+            [&](std::size_t a, std::size_t b) { return std::abs(eigenvalues[a]) > std::abs(eigenvalues[b]); });
+  std::vector<double> h(eigenvalues.size(), std::numeric_limits<double>::infinity());
+  for (const std::size_t i : order) {
+    const std::complex<double> lambda = eigenvalues[i];
     const double mag = std::abs(lambda);
     if (!(lambda.real() < 0) || !(mag > 0)) continue;
+    if (kStableRadius / mag > hMin) break;
     const std::complex<double> dir = lambda / mag;
     auto stable = [&](double x) { return std::abs(calcRkMersonStabilityFunction(x * dir)) <= 1.0; };
     // The first x = h |lambda| along the ray where |R| exceeds 1: scanned in
@@ -98,16 +110,20 @@ double calcRkMersonStabilityLimit(const std::vector<std::complex<double>>& eigen
       lo = x;
     }
     if (hi == 0) continue;  // stable along the whole scanned ray
-    for (int i = 0; i < 40; ++i) {
+    for (int k = 0; k < 40; ++k) {
       const double mid = 0.5 * (lo + hi);
       (stable(mid) ? lo : hi) = mid;
     }
-    const double h = lo / mag;
-    if (h < hMin) {
-      hMin = h;
-      if (limiting) *limiting = lambda;
-    }
+    h[i] = lo / mag;
+    hMin = std::min(hMin, h[i]);
   }
+  // The limiting eigenvalue: the first in the given order that sets the limit.
+  if (limiting)
+    for (std::size_t i = 0; i < h.size(); ++i)
+      if (h[i] == hMin) {
+        *limiting = eigenvalues[i];
+        break;
+      }
   return hMin;
 }
 
