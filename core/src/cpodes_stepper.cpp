@@ -185,7 +185,16 @@ bool CpodesStepper::step() {
   cpodesMessage_.clear();
   callbackError_.clear();
   double t = state_.getTime();
-  const int flag = cpodes_->step(finalTime_, &t, y_, yp_, SimTK::CPodes::OneStepTstop);
+  const bool stop = std::isfinite(finalTime_);
+  const int flag = cpodes_->step(stop ? finalTime_ : t + 1, &t, y_, yp_,
+                                 stop ? SimTK::CPodes::OneStepTstop : SimTK::CPodes::OneStep);
+  if (flag == SimTK::CPodes::TooClose && stop) {
+    // The final time is within rounding of the state's (a restart just
+    // before it): nothing to integrate, as Simbody's CPodesIntegrator does.
+    state_.setTime(finalTime_);
+    system_.realize(state_, SimTK::Stage::Velocity);
+    return true;
+  }
   throwIfFailed(flag, "a step");
   // The step's last call was its projection (CPODES projects after the
   // corrector, before the error test; an accepted step evaluates nothing

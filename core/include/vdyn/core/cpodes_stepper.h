@@ -48,7 +48,8 @@ class CpodesStepper {
   /// taken for the first Newton matrix instead of computing one.
   /// Throws Error if CPodes cannot start.
   void initialize(const SimTK::State& state, const Eigen::MatrixXd* jacobian = nullptr);
-  /// The time CPodes must not step past (s).
+  /// The time CPodes must not step past (s); without one, step() takes
+  /// CPodes's steps with no bound.
   void setFinalTime(double t);
   /// One internal step, not past the final time; returns true when the
   /// final time is reached. Throws Error (with CPodes's reason and the
