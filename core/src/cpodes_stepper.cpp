@@ -196,11 +196,11 @@ bool CpodesStepper::step() {
     return true;
   }
   throwIfFailed(flag, "a step");
-  // The step's last call was its projection (CPODES projects after the
-  // corrector, before the error test; an accepted step evaluates nothing
-  // after it): the work state then holds the step's end, realized through
-  // Velocity, and becomes it. CPodes's y is that state's y plus a correction
-  // it computed as (projected - y): equal to rounding, checked.
+  // An accepted step's last call is normally its projection (no evaluation
+  // follows it; on the peer scene every step): the work state then holds the
+  // step's end, realized through Velocity, and becomes it. CPodes's y is the
+  // unprojected y plus the correction (projected - y): equal to rounding,
+  // checked here, as are the time and the stage; else the end is realized.
   bool atEnd = work_.getTime() == t && work_.getSystemStage() >= SimTK::Stage::Velocity;
   if (atEnd) {
     const SimTK::Vector& w = work_.getY();

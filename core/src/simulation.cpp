@@ -96,7 +96,7 @@ class Stepping {
     if (!cpodes_) return integ_->stepTo(finalTime_);
     return cpodes_->step() ? SimTK::Integrator::EndOfSimulation : SimTK::Integrator::TimeHasAdvanced;
   }
-  /// The last step's end (Simbody's: realized through Acceleration; CPodes's: through Velocity).
+  /// The last step's end (Simbody's as its integrator leaves it; CPodes's realized through Velocity).
   const SimTK::State& getState() const { return cpodes_ ? cpodes_->getState() : integ_->getState(); }
   /// Simbody's advanced state (the step's end, where getState() may be interpolated); CPodes's step end.
   const SimTK::State& getAdvancedState() const { return cpodes_ ? cpodes_->getState() : integ_->getAdvancedState(); }
