@@ -275,6 +275,44 @@ TEST(CpodesStepper, StiffDampedSliderMeetsItsClosedForm) {
               own->getNumStepsTaken(), own->getNumJacobians(), own->getNumRealizations(), err);
 }
 
+// An evaluation that throws (a force leaving its regime at t = 0.5 s) is a
+// recoverable failure for CPodes, which cuts its step and tries again; when it
+// cannot get past (its step would fall below the floor, 1e-12 s here), the
+// run ends with an Error naming the time, CPodes's reason and the
+// evaluation's message, instead of creeping up to 0.5 s forever.
+TEST(CpodesStepper, AnEvaluationThatThrowsEndsTheRunWithItsMessage) {
+  struct Breaks : SimTK::Force::Custom::Implementation {
+    void calcForce(const SimTK::State& s, SimTK::Vector_<SimTK::SpatialVec>&, SimTK::Vector_<SimTK::Vec3>&,
+                   SimTK::Vector&) const override {
+      if (s.getTime() > 0.5) throw Error("the test force left its regime at t = " + formatValue(s.getTime()) + " s");
+    }
+    SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
+  };
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter(system);
+  SimTK::GeneralForceSubsystem forces(system);
+  SimTK::MobilizedBody::Slider body(matter.Ground(), SimTK::MassProperties(2.0, SimTK::Vec3(0), SimTK::Inertia(1)));
+  SimTK::Force::MobilityLinearSpring(forces, body, SimTK::MobilizerQIndex(0), 800.0, 0.0);
+  SimTK::Force::Custom(forces, new Breaks);
+  system.realizeTopology();
+  SimTK::State s = system.getDefaultState();
+  body.setQ(s, 0.1);
+  CpodesStepper st(system, IntegratorSettings());
+  st.setFinalTime(2.0);
+  st.initialize(s);
+  const std::string e = errorOf([&] {
+    while (!st.step()) {
+    }
+  });
+  EXPECT_EQ(e.rfind("cpodes: a step failed at t = 0.4999999999", 0), 0u) << e;
+  EXPECT_NE(e.find("repeated recoverable ODE function errors"), std::string::npos) << e;
+  EXPECT_NE(e.find("last evaluation failed: the test force left its regime at t = 0.5000000000"), std::string::npos)
+      << e;
+  EXPECT_LE(st.getTime(), 0.5);
+  EXPECT_GT(st.getTime(), 0.5 - 1e-9);
+  std::printf("%s\n", e.c_str());
+}
+
 TEST(Scene, PaysOnlyForRequestedCosts) {
   // A scene that asks for no cost integral carries no extra state variable.
   QuarterCar plain(parse(quarterCarJson()));

@@ -173,11 +173,23 @@ void CpodesStepper::initialize(const SimTK::State& state, const Eigen::MatrixXd*
   throwIfFailed(cpodes_->projDefine(), "projDefine");
   if (settings_.max_step_s > 0) throwIfFailed(cpodes_->setMaxStep(settings_.max_step_s), "setMaxStep");
   if (std::isfinite(finalTime_)) throwIfFailed(cpodes_->setStopTime(finalTime_), "setStopTime");
+  setMinStep();
+}
+
+// A floor under CPodes's step, 1e-12 s times the larger of 1 and |t| at the
+// start and the end: where failures (a non-converging corrector, an
+// evaluation that throws) would cut the step below it, CPodes stops with an
+// error instead of creeping up to the failure in ever smaller steps.
+void CpodesStepper::setMinStep() {
+  if (!cpodes_) return;
+  const double t = std::max({1.0, std::abs(state_.getTime()), std::isfinite(finalTime_) ? std::abs(finalTime_) : 0.0});
+  throwIfFailed(cpodes_->setMinStep(1e-12 * t), "setMinStep");
 }
 
 void CpodesStepper::setFinalTime(double t) {
   finalTime_ = t;
   if (cpodes_) throwIfFailed(cpodes_->setStopTime(t), "setStopTime");
+  setMinStep();
 }
 
 bool CpodesStepper::step() {

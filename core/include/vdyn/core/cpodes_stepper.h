@@ -79,6 +79,7 @@ class CpodesStepper {
   friend class Ode;
   static int jacobianCallback(int n, double t, void* y, void* fy, void* jac, void* self, void*, void*, void*);
   void throwIfFailed(int flag, const std::string& doing) const;
+  void setMinStep();
   /// f(t, y) in work_ (prescribed q and u applied), counted.
   const SimTK::Vector& evaluate(double t, const SimTK::Vector& y);
 
