@@ -156,6 +156,20 @@ TEST(Integrators, EveryNameIsConstructedWithItsSettings) {
 // negative real axis is the root of R(-x) = -1 (x = 3.5 to two figures).
 // The Jacobian of a damped oscillator on a slider (m x'' + c x' + k x = 0) has
 // the closed-form eigenvalues (-c +- sqrt(c^2 - 4 m k)) / (2 m).
+// A body of mass m on a slider with a linear spring k and, if c > 0, a
+// linear damper c: m x'' + c x' + k x = 0 (kg, N/m, N s/m).
+struct DampedSlider {
+  SimTK::MultibodySystem system;
+  SimTK::SimbodyMatterSubsystem matter{system};
+  SimTK::GeneralForceSubsystem forces{system};
+  SimTK::MobilizedBody::Slider body;
+  DampedSlider(double m, double k, double c)
+      : body(matter.Ground(), SimTK::MassProperties(m, SimTK::Vec3(0), SimTK::Inertia(1))) {
+    SimTK::Force::MobilityLinearSpring(forces, body, SimTK::MobilizerQIndex(0), k, 0.0);
+    if (c > 0) SimTK::Force::MobilityLinearDamper(forces, body, SimTK::MobilizerUIndex(0), c);
+  }
+};
+
 TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
   using C = std::complex<double>;
   for (C z : {C(-0.5, 0), C(-2, 1), C(-3.3, 0), C(0.1, 2.5)}) {
@@ -190,12 +204,9 @@ TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
   EXPECT_EQ(calcRkMersonStabilityLimit({C(-20, 112)}), hPair);
 
   const double m = 2.0, k = 800.0, c = 90.0;  // kg, N/m, N s/m: overdamped
-  SimTK::MultibodySystem system;
-  SimTK::SimbodyMatterSubsystem matter(system);
-  SimTK::GeneralForceSubsystem forces(system);
-  SimTK::MobilizedBody::Slider body(matter.Ground(), SimTK::MassProperties(m, SimTK::Vec3(0), SimTK::Inertia(1)));
-  SimTK::Force::MobilityLinearSpring(forces, body, SimTK::MobilizerQIndex(0), k, 0.0);
-  SimTK::Force::MobilityLinearDamper(forces, body, SimTK::MobilizerUIndex(0), c);
+  DampedSlider slider(m, k, c);
+  const SimTK::MultibodySystem& system = slider.system;
+  const SimTK::MobilizedBody::Slider& body = slider.body;
   system.realizeTopology();
   SimTK::State s = system.getDefaultState();
   body.setQ(s, 0.01);
@@ -227,12 +238,9 @@ TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
 // evaluations fewer.
 TEST(CpodesStepper, StiffDampedSliderMeetsItsClosedForm) {
   const double m = 2.0, k = 800.0, c = 2000.0, x0 = 0.1;  // kg, N/m, N s/m, m
-  SimTK::MultibodySystem system;
-  SimTK::SimbodyMatterSubsystem matter(system);
-  SimTK::GeneralForceSubsystem forces(system);
-  SimTK::MobilizedBody::Slider body(matter.Ground(), SimTK::MassProperties(m, SimTK::Vec3(0), SimTK::Inertia(1)));
-  SimTK::Force::MobilityLinearSpring(forces, body, SimTK::MobilizerQIndex(0), k, 0.0);
-  SimTK::Force::MobilityLinearDamper(forces, body, SimTK::MobilizerUIndex(0), c);
+  DampedSlider slider(m, k, c);
+  const SimTK::MultibodySystem& system = slider.system;
+  const SimTK::MobilizedBody::Slider& body = slider.body;
   system.realizeTopology();
   SimTK::State s = system.getDefaultState();
   body.setQ(s, x0);
@@ -288,16 +296,12 @@ TEST(CpodesStepper, AnEvaluationThatThrowsEndsTheRunWithItsMessage) {
     }
     SimTK::Real calcPotentialEnergy(const SimTK::State&) const override { return 0; }
   };
-  SimTK::MultibodySystem system;
-  SimTK::SimbodyMatterSubsystem matter(system);
-  SimTK::GeneralForceSubsystem forces(system);
-  SimTK::MobilizedBody::Slider body(matter.Ground(), SimTK::MassProperties(2.0, SimTK::Vec3(0), SimTK::Inertia(1)));
-  SimTK::Force::MobilityLinearSpring(forces, body, SimTK::MobilizerQIndex(0), 800.0, 0.0);
-  SimTK::Force::Custom(forces, new Breaks);
-  system.realizeTopology();
-  SimTK::State s = system.getDefaultState();
-  body.setQ(s, 0.1);
-  CpodesStepper st(system, IntegratorSettings());
+  DampedSlider slider(2.0, 800.0, 0.0);
+  SimTK::Force::Custom(slider.forces, new Breaks);
+  slider.system.realizeTopology();
+  SimTK::State s = slider.system.getDefaultState();
+  slider.body.setQ(s, 0.1);
+  CpodesStepper st(slider.system, IntegratorSettings());
   st.setFinalTime(2.0);
   st.initialize(s);
   const std::string e = errorOf([&] {
