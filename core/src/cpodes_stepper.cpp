@@ -63,11 +63,7 @@ class CpodesStepper::Ode : public SimTK::CPodesSystem {
     const SimTK::System& sys = st_.system_;
     SimTK::State& w = st_.work_;
     try {
-      w.setTime(t);
-      w.updY() = y;
-      sys.realize(w, SimTK::Stage::Time);
-      sys.prescribeQ(w);
-      sys.realize(w, SimTK::Stage::Position);
+      st_.setWork(t, y);
       SimTK::ProjectOptions options(st_.settings_.constraint_tolerance);
       options.setOption(SimTK::ProjectOptions::LocalOnly);
       options.setOption(SimTK::ProjectOptions::DontThrow);
@@ -108,12 +104,16 @@ CpodesStepper::CpodesStepper(const SimTK::System& system, const IntegratorSettin
 
 CpodesStepper::~CpodesStepper() = default;
 
-const SimTK::Vector& CpodesStepper::evaluate(double t, const SimTK::Vector& y) {
+void CpodesStepper::setWork(double t, const SimTK::Vector& y) {
   work_.setTime(t);
   work_.updY() = y;
   system_.realize(work_, SimTK::Stage::Time);
   system_.prescribeQ(work_);
   system_.realize(work_, SimTK::Stage::Position);
+}
+
+const SimTK::Vector& CpodesStepper::evaluate(double t, const SimTK::Vector& y) {
+  setWork(t, y);
   system_.prescribeU(work_);
   system_.realize(work_, SimTK::Stage::Acceleration);
   ++evaluations_;
@@ -145,13 +145,12 @@ void CpodesStepper::initialize(const SimTK::State& state, const Eigen::MatrixXd*
   }
   system_.realize(state_, SimTK::Stage::Velocity);
   const int n = state_.getNY();
-  handed_ = false;
+  handedJacobian_.resize(0, 0);
   if (jacobian) {
     if (jacobian->rows() != n || jacobian->cols() != n)
       throw Error("cpodes: the Jacobian handed to initialize is " + std::to_string(jacobian->rows()) + " x " +
                   std::to_string(jacobian->cols()) + ", the state has " + std::to_string(n) + " entries");
     handedJacobian_ = *jacobian;
-    handed_ = true;
   }
   y_ = state_.getY();
   try {
@@ -226,8 +225,8 @@ bool CpodesStepper::step() {
     state_.updY() = y_;
     system_.realize(state_, SimTK::Stage::Velocity);
   }
-  const double tol = 1e-12 * std::max(1.0, std::abs(finalTime_));
-  return flag == SimTK::CPodes::TstopReturn || t >= finalTime_ - tol;
+  if (!stop) return false;
+  return flag == SimTK::CPodes::TstopReturn || t >= finalTime_ - 1e-12 * std::max(1.0, std::abs(finalTime_));
 }
 
 void CpodesStepper::interpolate(double t, SimTK::Vector& y) const {
@@ -274,25 +273,20 @@ int CpodesStepper::jacobianCallback(int n, double t, void* y, void* fy, void* ja
                         std::to_string(J->M) + " x " + std::to_string(J->N) + ", n " + std::to_string(n);
     return SimTK::CPodes::UnrecoverableError;
   }
-  if (st.handed_) {
+  if (st.handedJacobian_.size() != 0) {
     // CPodes's first Newton matrix: asked at its first step's predicted y
     // (y0 + h y0'), answered with the Jacobian at y0, as CPodes itself
-    // answers with a Jacobian kept from up to 50 steps before.
-    st.handed_ = false;
+    // answers with a Jacobian kept from up to 50 steps before. Used once.
     for (int j = 0; j < n; ++j)
       for (int i = 0; i < n; ++i) J->cols[j][i] = st.handedJacobian_(i, j);
+    st.handedJacobian_.resize(0, 0);
     return SimTK::CPodes::Success;
   }
   ++st.jacobians_;
   try {
-    SimTK::State& w = st.work_;
-    w.setTime(t);
-    w.updY() = yv;
-    st.system_.realize(w, SimTK::Stage::Time);
-    st.system_.prescribeQ(w);
-    st.system_.realize(w, SimTK::Stage::Position);
-    st.system_.prescribeU(w);
-    calcStateDerivativeJacobianColumns(st.system_, w, f0, J->cols, &st.evaluations_);
+    st.setWork(t, yv);
+    st.system_.prescribeU(st.work_);
+    calcStateDerivativeJacobianColumns(st.system_, st.work_, f0, J->cols, &st.evaluations_);
   } catch (const std::exception& e) {
     st.callbackError_ = e.what();
     return SimTK::CPodes::RecoverableError;

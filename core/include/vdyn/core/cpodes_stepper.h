@@ -80,6 +80,8 @@ class CpodesStepper {
   static int jacobianCallback(int n, double t, void* y, void* fy, void* jac, void* self, void*, void*, void*);
   void throwIfFailed(int flag, const std::string& doing) const;
   void setMinStep();
+  /// work_ at (t, y), prescribed q applied, realized through Position.
+  void setWork(double t, const SimTK::Vector& y);
   /// f(t, y) in work_ (prescribed q and u applied), counted.
   const SimTK::Vector& evaluate(double t, const SimTK::Vector& y);
 
@@ -90,8 +92,7 @@ class CpodesStepper {
   SimTK::State state_;      // the last step's end
   SimTK::State work_;       // where f and the Jacobian's columns are evaluated
   SimTK::Vector y_, yp_;    // CPodes's y and y' at the last step's end
-  Eigen::MatrixXd handedJacobian_;
-  bool handed_ = false;
+  Eigen::MatrixXd handedJacobian_;  // for CPodes's first Jacobian (empty: none, or used)
   double finalTime_ = SimTK::Infinity;
   long evaluations_ = 0, jacobians_ = 0, projections_ = 0;
   std::string callbackError_;  // the exception a callback caught, for the message
