@@ -204,10 +204,10 @@ TEST(Arclength, BicycleFoldInSteeringAgreesWithTheLastConvergedPointAndPassesIt)
   const double ay = sc.evalOutput("chassis.yaw_rate_rad_s", at.state) * U;
   std::printf("bicycle %g m/s: fold at front steer %.6f deg (a_y ~ %.4f m/s^2; bracket %.1e deg, %d location "
               "iterations), least eigenvalue %.3e; old limit (last converged, 0.5 deg grid) %.2f deg; %d steps, %d "
-              "rejected, %d corrector iterations\n",
+              "rejected, %d corrector iterations, %d Jacobians, %d residuals, %d quasi-Newton fallbacks\n",
               U, fold->point.lambda / kDeg, ay, fold->bracket_length / kDeg, fold->location_iterations,
               fold->point.eigenvalues.front().real(), oldLimit / kDeg, r.steps, r.rejected_steps,
-              r.corrector_iterations);
+              r.corrector_iterations, r.jacobians, r.residual_evaluations, r.quasi_newton_fallbacks);
   EXPECT_TRUE(fold->located);
   EXPECT_GE(fold->point.lambda, oldLimit);
   EXPECT_LT(fold->point.lambda, oldLimit + 0.5 * kDeg);
@@ -266,4 +266,52 @@ TEST(Arclength, SteadyStateFromStraightRunningStopsAtTheFold) {
   const double foldDeg = std::stod(msg.substr(head.size()));
   EXPECT_NEAR(foldDeg, 1.851124, 1e-5);
   EXPECT_NE(msg.find("lateral acceleration 6.74"), std::string::npos) << msg;
+}
+
+// The quasi-Newton corrector (the start's Jacobian with Broyden updates)
+// against Newton with a fresh Jacobian at every iteration, on a smooth curved
+// branch, F = [x1^3 + x1 - lambda, x2 - sin(3 x1)] from lambda = -3 to 3:
+// every point of both runs is a solution to the same tolerance, both reach the
+// end, and the quasi-Newton run takes the tangents' Jacobians and few more
+// (one per accepted step, the start's, and those of the steps Newton retried).
+TEST(Arclength, QuasiNewtonCorrectorMeetsTheSameTolerancesWithFewerJacobians) {
+  ArclengthSystem s;
+  s.x_scale = Eigen::VectorXd::Ones(2);
+  s.lambda_scale = 1;
+  s.residual = [](const Eigen::VectorXd& x, double l) {
+    Eigen::VectorXd r(2);
+    r << x[0] * x[0] * x[0] + x[0] - l, x[1] - std::sin(3 * x[0]);
+    return r;
+  };
+  s.jacobian = [](const Eigen::VectorXd& x, double, const Eigen::VectorXd&) {
+    Eigen::MatrixXd J(2, 3);
+    J << 3 * x[0] * x[0] + 1, 0, -1, -3 * std::cos(3 * x[0]), 1, 0;
+    return J;
+  };
+  s.converged = [](const Eigen::VectorXd& r) { return r.lpNorm<Eigen::Infinity>() <= 1e-12; };
+  ArclengthOptions o;
+  o.step = 0.05;
+  o.max_step = 0.5;
+  o.lambda_max = 3;
+  Eigen::VectorXd x0(2);
+  const double x1 = -1.2134116627622296;  // x1^3 + x1 = -3
+  x0 << x1, std::sin(3 * x1);
+  ASSERT_LE(s.residual(x0, -3.0).lpNorm<Eigen::Infinity>(), 1e-12);
+  ArclengthOptions on = o;
+  on.quasi_newton = false;
+  const ArclengthResult q = continueArclength(s, x0, -3.0, o), n = continueArclength(s, x0, -3.0, on);
+  std::printf("quasi-Newton: %d steps, %d rejected, %d Jacobians, %d residuals, %d fallbacks; Newton: %d steps, %d "
+              "rejected, %d Jacobians, %d residuals\n",
+              q.steps, q.rejected_steps, q.jacobians, q.residual_evaluations, q.quasi_newton_fallbacks, n.steps,
+              n.rejected_steps, n.jacobians, n.residual_evaluations);
+  for (const ArclengthResult* r : {&q, &n}) {
+    EXPECT_EQ(r->stop_reason, "lambda_range");
+    EXPECT_GT(r->points.back().lambda, 3.0);
+    for (const auto& p : r->points) EXPECT_LE(s.residual(p.x, p.lambda).lpNorm<Eigen::Infinity>(), 1e-12);
+  }
+  EXPECT_EQ(n.quasi_newton_fallbacks, 0);
+  // Every Jacobian beyond one per tangent is a Newton retry's.
+  EXPECT_GE(q.jacobians, q.steps + 1);
+  EXPECT_LE(q.jacobians - (q.steps + 1), o.max_corrector_iterations * q.quasi_newton_fallbacks);
+  EXPECT_LT(q.jacobians, n.jacobians / 2);
 }

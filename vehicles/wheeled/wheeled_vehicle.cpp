@@ -284,6 +284,12 @@ WheeledVehicle::WheeledVehicle(const WheeledVehicleParams& params, const PluginR
     const Scene* scene = scene_.get();
     const ReducedDenseRows* rows = dense_;
     service->use_simbody_rows = [scene, rows](SimTK::State& s) { useSimbodyRowsOf(*scene, rows, s); };
+    // The formulation in effect decides (a scene that asks for "reduced" keeps
+    // Simbody's rows). The vehicle owns the scene, and so this service, and
+    // is not movable.
+    service->use_dense_rows = [this](SimTK::State& s) {
+      if (getFormulation().name == "dense") useDenseRows(s);
+    };
     sc.setService<const ConstraintRowsService>(kConstraintRowsService, service);
   } else if (templates_.name == "reduced" && p_.formulation == "dense") {
     throw Error("vehicle formulation \"dense\": a reduced template has no dense rows");

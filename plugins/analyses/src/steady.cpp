@@ -166,7 +166,11 @@ class SteadyStateAnalysis : public Analysis {
                    {"force_residual_N", ss.force_residual},
                    {"wall_time_s", ss.wall_time_s},
                    {"vehicle", ctx.built.vehicle->describe(initial)}};
-    if (s_.start == "straight") res.summary["homotopy_steps"] = rep.arclength_steps;
+    if (s_.start == "straight")
+      res.summary.update({{"homotopy_steps", rep.arclength_steps},
+                          {"homotopy_jacobians", rep.jacobians},
+                          {"homotopy_residual_evaluations", rep.residual_evaluations},
+                          {"homotopy_quasi_newton_fallbacks", rep.quasi_newton_fallbacks}});
     if (s_.stability) {
       const auto t0 = std::chrono::steady_clock::now();
       const StabilityResult st = solver.calcStability(ss, s_.stability_tolerance_per_s);

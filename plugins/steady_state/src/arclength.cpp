@@ -36,10 +36,11 @@ class Continuer {
     return y.cwiseQuotient(S_);
   }
 
-  /// Unit tangent (scaled) at a solution, oriented so that t . orient > 0.
+  /// Unit tangent (scaled) at a solution, oriented so that t . orient > 0,
+  /// from a fresh Jacobian there (kept as the next corrector's first matrix).
   Eigen::VectorXd tangentAt(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& r,
-                            const Eigen::VectorXd& orient) const {
-    const Eigen::MatrixXd Js = R_.asDiagonal() * sys_.jacobian(x, lambda, r) * S_.asDiagonal();
+                            const Eigen::VectorXd& orient) {
+    const Eigen::MatrixXd Js = scaledJacobian(x, lambda, r);
     Eigen::MatrixXd A(n_ + 1, n_ + 1);
     A.topRows(n_) = Js;
     A.row(n_) = orient.transpose();
@@ -49,28 +50,75 @@ class Continuer {
     if (!t.allFinite() || t.norm() == 0)
       throw Error("pseudo-arclength continuation: no tangent at lambda = " + formatValue(lambda) +
                   " (the augmented Jacobian is singular: a branch point)");
+    keep(x, lambda, Js);
     return t / t.norm();
   }
 
-  /// Newton on [F; t.(y - y0) - ds] from the predictor y0 + ds t. Returns
-  /// false (with `why`) when it does not converge.
+  /// The Jacobian kept for the solution (x, lambda), if any: the last three
+  /// tangents' Jacobians are kept, the least recently used replaced (a step
+  /// starts from the last point; a fold's or Hopf point's location starts
+  /// every trial from the bracket's first point while its trials add theirs).
+  const Eigen::MatrixXd* keptJacobian(const Eigen::VectorXd& x, double lambda) {
+    for (Kept& k : kept_)
+      if (k.used > 0 && k.lambda == lambda && k.x.size() == x.size() && k.x == x) {
+        k.used = ++clock_;
+        return &k.Js;
+      }
+    return nullptr;
+  }
+
+  /// The corrector from the predictor y0 + ds t on [F; t.(y - y0) - ds].
+  /// First quasi-Newton: the matrix of the start's tangent (its Jacobian,
+  /// computed there for the tangent anyway) with Broyden's rank-one update
+  /// of the F rows after every iteration, so that a step usually costs no
+  /// Jacobian beyond its tangent's. Should that not converge, Newton with a
+  /// fresh Jacobian at every iteration (the corrector the quasi-Newton one
+  /// stands in for) retries the same step before it counts as failed. Both
+  /// stop on the same test (converged(F) and the arclength condition), so
+  /// the points are solutions to the same tolerances either way. Returns
+  /// false (with `why`, Newton's reason) when neither converges.
   bool correct(const ArclengthPoint& from, double ds, ArclengthPoint& out, std::string& why) {
+    if (const Eigen::MatrixXd* J = opt_.quasi_newton ? keptJacobian(from.x, from.lambda) : nullptr) {
+      Eigen::MatrixXd B = *J;
+      std::string quasiWhy;
+      if (correctWith(from, ds, &B, out, quasiWhy)) {
+        lastQuasi_ = true;
+        return true;
+      }
+      ++quasiFailures_;
+    }
+    lastQuasi_ = false;
+    return correctWith(from, ds, nullptr, out, why);
+  }
+
+  /// One corrector: quasi-Newton from *B (updated in place), or Newton with
+  /// fresh Jacobians when B is null.
+  bool correctWith(const ArclengthPoint& from, double ds, Eigen::MatrixXd* B, ArclengthPoint& out, std::string& why) {
     const Eigen::VectorXd& t = from.tangent;
     const Eigen::VectorXd y0 = scaled(from.x, from.lambda);
     const double dst = ds / sys_.lambda_scale;
     const Eigen::VectorXd yp = y0 + dst * t;
     Eigen::VectorXd y = yp;
-    Eigen::VectorXd x, r;
+    Eigen::VectorXd x, r, Rr, d;
     double lambda = 0;
     for (int it = 0;; ++it) {
       x = y.head(n_).cwiseProduct(S_.head(n_));
       lambda = y[n_] * S_[n_];
       r = sys_.residual(x, lambda);
+      ++residuals_;
       const double g = t.dot(y - y0) - dst;
       if (!r.allFinite()) {
         why = "non-finite residual";
+        iterations_ += it;
         return false;
       }
+      const Eigen::VectorXd RrNew = r.cwiseProduct(R_);
+      if (B && it > 0) {
+        // Broyden: B d = (change of the scaled F over the step d).
+        const double dd = d.squaredNorm();
+        if (dd > 0) *B += ((RrNew - Rr) - *B * d) * (d.transpose() / dd);
+      }
+      Rr = RrNew;
       if (sys_.converged(r) && std::abs(g) <= opt_.arclength_tolerance) {
         out.x = x;
         out.lambda = lambda;
@@ -82,17 +130,17 @@ class Continuer {
         return true;
       }
       if (it == opt_.max_corrector_iterations) {
-        why = std::to_string(it) + " corrector iterations, scaled residual " + formatValue(r.cwiseProduct(R_).norm());
+        why = std::to_string(it) + " corrector iterations, scaled residual " + formatValue(Rr.norm());
         iterations_ += it;
         return false;
       }
       Eigen::MatrixXd A(n_ + 1, n_ + 1);
-      A.topRows(n_) = R_.asDiagonal() * sys_.jacobian(x, lambda, r) * S_.asDiagonal();
+      A.topRows(n_) = B ? *B : scaledJacobian(x, lambda, r);
       A.row(n_) = t.transpose();
       Eigen::VectorXd b(n_ + 1);
-      b.head(n_) = -r.cwiseProduct(R_);
+      b.head(n_) = -Rr;
       b[n_] = -g;
-      const Eigen::VectorXd d = A.partialPivLu().solve(b);
+      d = A.partialPivLu().solve(b);
       if (!d.allFinite()) {
         why = "singular corrector matrix";
         iterations_ += it;
@@ -173,6 +221,7 @@ class Continuer {
                   formatValue(opt_.step) + ") <= max_step (" + formatValue(opt_.max_step) + ")");
     ArclengthResult res;
     const Eigen::VectorXd r0 = sys_.residual(x0, lambda0);
+    ++residuals_;
     if (!sys_.converged(r0))
       throw Error("pseudo-arclength continuation: the start at lambda = " + formatValue(lambda0) +
                   " is not a solution (scaled residual " + formatValue(r0.cwiseProduct(R_).norm()) + ")");
@@ -200,6 +249,7 @@ class Continuer {
                       "): " + why);
         continue;
       }
+      const bool quasi = lastQuasi_;  // this step's corrector (the location below runs more)
       ++res.steps;
       addEigenvalues(next);
       // Test functions between last and next.
@@ -220,7 +270,7 @@ class Continuer {
         folds += f.kind == "fold";
         res.special.push_back(std::move(f));
       }
-      if (next.corrector_iterations <= opt_.fast_iterations) ds = std::min(1.5 * ds, opt_.max_step);
+      if (next.corrector_iterations <= (quasi ? 2 : 1) * opt_.fast_iterations) ds = std::min(1.5 * ds, opt_.max_step);
       const bool outside = next.lambda < opt_.lambda_min || next.lambda > opt_.lambda_max;
       res.points.push_back(std::move(next));
       if (outside) {
@@ -236,15 +286,42 @@ class Continuer {
     }
     if (res.stop_reason.empty()) res.stop_reason = "max_points";
     res.corrector_iterations = iterations_;
+    res.jacobians = jacobians_;
+    res.residual_evaluations = residuals_;
+    res.quasi_newton_fallbacks = quasiFailures_;
     return res;
   }
 
  private:
+  /// R J S: the Jacobian in scaled unknowns and weighted equations.
+  Eigen::MatrixXd scaledJacobian(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& r) {
+    ++jacobians_;
+    return R_.asDiagonal() * sys_.jacobian(x, lambda, r) * S_.asDiagonal();
+  }
+  void keep(const Eigen::VectorXd& x, double lambda, const Eigen::MatrixXd& Js) {
+    Kept* k = &kept_[0];
+    for (Kept& c : kept_)
+      if (c.used < k->used) k = &c;
+    k->used = ++clock_;
+    k->x = x;
+    k->lambda = lambda;
+    k->Js = Js;
+  }
+
+  struct Kept {
+    long used = 0;  // 0: empty; else the clock at its last use
+    Eigen::VectorXd x;
+    double lambda = 0;
+    Eigen::MatrixXd Js;
+  };
   const ArclengthSystem& sys_;
   const ArclengthOptions& opt_;
   int n_ = 0;
   Eigen::VectorXd S_, R_;
-  int iterations_ = 0;
+  int iterations_ = 0, jacobians_ = 0, residuals_ = 0, quasiFailures_ = 0;
+  bool lastQuasi_ = false;
+  Kept kept_[3];
+  long clock_ = 0;
 };
 
 }  // namespace

@@ -703,9 +703,21 @@ LinearModel SteadyStateSolver::calcLinearModel(const SteadyStateResult& steady, 
   red.toState(r0, s);
   const int N = red.size();
   const int ni = int(inputs.size()), no = int(outputs.size());
+  // The rates come from the scene's fastest forward dynamics of the same
+  // equations: a state whose rows are solved densely where the scene offers
+  // it (ConstraintRowsService::use_dense_rows; its rows' drift terms vanish
+  // on the manifold and, to first order, along its tangents), Simbody's
+  // rows otherwise. The tangents (below) come from Simbody's constraint errors.
+  SimTK::State sr = s;
+  if (scene_.hasService(kConstraintRowsService)) {
+    scene_.getService<const ConstraintRowsService>(kConstraintRowsService)->use_dense_rows(sr);
+    system.realize(sr, SimTK::Stage::Instance);
+  }
   auto setInput = [&](int k, double v, double vd, double vdd) {
-    inputs[k].set(s, v, vd, vdd);
-    s.invalidateAll(SimTK::Stage::Position);
+    for (SimTK::State* st : {&s, &sr}) {
+      inputs[k].set(*st, v, vd, vdd);
+      st->invalidateAll(SimTK::Stage::Position);
+    }
   };
 
   // Tangent space of the constraint manifold: null space of d[qerr; uerr]/dr.
@@ -743,14 +755,14 @@ LinearModel SteadyStateSolver::calcLinearModel(const SteadyStateResult& steady, 
   const int D = int(T.cols());
   // State rate and outputs at a reduced state (outputs need Acceleration: rate() realizes it).
   auto rateAndOutputs = [&](const Eigen::VectorXd& r) {
-    red.toState(r, s);
+    red.toState(r, sr);
     Eigen::VectorXd d(N + no);
-    d.head(N) = red.rate(s);
-    for (int k = 0; k < no; ++k) d[N + k] = outputs[k].calc(s);
+    d.head(N) = red.rate(sr);
+    for (int k = 0; k < no; ++k) d[N + k] = outputs[k].calc(sr);
     return d;
   };
-  red.toState(r0, s);
-  lastEquilibriumResidual_ = maxAbs(red.rate(s));
+  red.toState(r0, sr);
+  lastEquilibriumResidual_ = maxAbs(red.rate(sr));
   LinearModel lin;
   for (const auto& i : inputs) lin.inputs.push_back(i.name);
   for (const auto& o : outputs) lin.outputs.push_back(o.name);

@@ -87,6 +87,9 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
     report->arclength_steps = ar.steps;
     report->rejected_steps = ar.rejected_steps;
     report->corrector_iterations = ar.corrector_iterations;
+    report->jacobians = ar.jacobians;
+    report->residual_evaluations = ar.residual_evaluations;
+    report->quasi_newton_fallbacks = ar.quasi_newton_fallbacks;
   }
   for (const auto& sp : ar.special) {
     if (sp.kind != "fold" || !(sp.point.lambda < T)) continue;

@@ -36,9 +36,13 @@ struct IntegralHandle {
 /// their constraint rows outside Simbody (a vehicle's dense forward dynamics,
 /// WheeledVehicle::useDenseRows) offers it; `use_simbody_rows` turns such a
 /// state into the same state with Simbody's rows (what a solver that takes the
-/// rows' multipliers as unknowns, the steady-state solver, needs).
+/// rows' multipliers as unknowns, the steady-state solver, needs), and
+/// `use_dense_rows` back (the same equations of motion, evaluated faster: what
+/// a linearisation by differences of the forward dynamics uses). Both leave
+/// q, u and z as they are.
 struct ConstraintRowsService {
   std::function<void(SimTK::State&)> use_simbody_rows;
+  std::function<void(SimTK::State&)> use_dense_rows;
 };
 inline constexpr const char* kConstraintRowsService = "constraint_rows";
 

@@ -7,13 +7,17 @@
 // Scaled variables y = [x / x_scale; lambda / lambda_scale]. From a solution
 // y_k with unit tangent t_k (the null vector of the scaled Jacobian
 // [F_x F_lambda], oriented like t_{k-1}), the predictor y_k + ds t_k /
-// lambda_scale is corrected by Newton on
+// lambda_scale is corrected on
 //     F(x; lambda) = 0,   t_k . (y - y_k) = ds / lambda_scale
-// (a fresh Jacobian each iteration). Arclength s is measured in the unit of
-// lambda: s^2 = sum (dx_i / x_scale_i)^2 lambda_scale^2 + dlambda^2, so
+// by quasi-Newton iterations (the Jacobian at y_k, which its tangent needed,
+// with Broyden's rank-one updates: one residual per iteration); a step they
+// do not converge on is retried by Newton with a fresh Jacobian at every
+// iteration before it counts as failed. Arclength s is measured in the unit
+// of lambda: s^2 = sum (dx_i / x_scale_i)^2 lambda_scale^2 + dlambda^2, so
 // |dlambda| <= ds always. Step control: the step grows (x1.5, up to
-// max_step) after a corrector of at most fast_iterations, halves on a failed
-// corrector; below min_step the continuation throws an Error naming it.
+// max_step) after a corrector of at most fast_iterations (2 fast_iterations
+// for the quasi-Newton one), halves on a failed corrector; below min_step
+// the continuation throws an Error naming it.
 //
 // Test functions between consecutive points:
 //   fold  tau = t_lambda, the lambda component of the unit tangent (equal in
@@ -58,7 +62,16 @@ struct ArclengthOptions {
   int max_points = 200;           ///< points after the start
   double lambda_min = -1e300, lambda_max = 1e300;  ///< stop on leaving [lambda_min, lambda_max]
   int max_corrector_iterations = 8;
-  int fast_iterations = 3;        ///< a corrector of at most this many iterations grows the step
+  /// Quasi-Newton correctors first (the start's Jacobian with Broyden
+  /// updates, Newton retrying a step they fail on); false: Newton with a
+  /// fresh Jacobian at every iteration only. The points meet the same
+  /// tolerances either way.
+  bool quasi_newton = true;
+  /// A corrector of at most this many iterations grows the step (twice as
+  /// many for the quasi-Newton corrector: Broyden's convergence is
+  /// superlinear, not quadratic, so the same predictor error takes about
+  /// twice the iterations, each one residual instead of a Jacobian).
+  int fast_iterations = 3;
   double arclength_tolerance = 1e-10;  ///< |t . (y - y_k) - ds| at convergence (scaled units)
   double location_tolerance = 1e-6;    ///< bracket length of a located fold / Hopf point, lambda's unit
   int max_location_iterations = 40;
@@ -101,6 +114,9 @@ struct ArclengthResult {
   int steps = 0;             ///< accepted steps
   int rejected_steps = 0;    ///< failed correctors (each halved the step)
   int corrector_iterations = 0;  ///< all Newton iterations (location included)
+  int jacobians = 0;             ///< system.jacobian calls (one per tangent, more where Newton retried)
+  int residual_evaluations = 0;  ///< system.residual calls
+  int quasi_newton_fallbacks = 0;  ///< steps the quasi-Newton corrector left to Newton
   std::string stop_reason;   ///< "max_points", "lambda_range", "folds"
 };
 

@@ -12,6 +12,9 @@ struct StraightStartReport {
   int arclength_steps = 0;     ///< pseudo-arclength steps of the homotopy
   int rejected_steps = 0;      ///< failed correctors (halved steps)
   int corrector_iterations = 0;
+  int jacobians = 0;             ///< the homotopy's Jacobians (ArclengthResult::jacobians)
+  int residual_evaluations = 0;  ///< the homotopy's residual evaluations
+  int quasi_newton_fallbacks = 0;  ///< steps its quasi-Newton corrector left to Newton
 };
 
 /// The steady state at the solver's problem time_s on the branch that
