@@ -273,6 +273,14 @@ class Continuer {
       if (next.corrector_iterations <= (quasi ? 2 : 1) * opt_.fast_iterations) ds = std::min(1.5 * ds, opt_.max_step);
       const bool outside = next.lambda < opt_.lambda_min || next.lambda > opt_.lambda_max;
       res.points.push_back(std::move(next));
+      if (opt_.stop_if) {
+        std::string why = opt_.stop_if(res.points.back());
+        if (!why.empty()) {
+          res.stop_reason = "stopped";
+          res.stop_message = std::move(why);
+          break;
+        }
+      }
       if (outside) {
         res.stop_reason = "lambda_range";
         break;

@@ -18,6 +18,23 @@ double lateralOf(const Scene& scene, const SteadyStateSolver& solver, const SimT
   return b.getBodyAngularVelocity(s)[2] * std::hypot(v[0], v[1]);
 }
 
+/// The tire whose normal load (an output ending in ".Fz_N") at `at` is least
+/// relative to its straight-running value in `start`, if that is at most
+/// `fraction` of it: a wheel lifting off. Empty name when none is.
+struct Unloaded {
+  std::string tire;
+  double fz = 0, fz0 = 0;
+};
+Unloaded findUnloaded(const Scene& scene, const SimTK::State& at, const SimTK::State& start, double fraction) {
+  Unloaded u;
+  for (const auto& n : scene.getOutputNames()) {
+    if (n.size() < 5 || n.compare(n.size() - 5, 5, ".Fz_N") != 0) continue;
+    const double f = scene.evalOutput(n, at), f0 = scene.evalOutput(n, start);
+    if (f0 > 0 && f <= fraction * f0 && (u.tire.empty() || f / f0 < u.fz / u.fz0)) u.tire = n, u.fz = f, u.fz0 = f0;
+  }
+  return u;
+}
+
 }  // namespace
 
 SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scene& scene, const SimTK::State& initial,
@@ -51,37 +68,45 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   o.stop_after_folds = 1;
   o.points_after_last_fold = 1;
   const auto setTime = [](SimTK::State& s, double t) { s.setTime(t); };
+  // A wheel lifting off puts a kink into the branch (the tire's normal load
+  // reaches zero; past it the wheel hangs and its spin is free: the steady
+  // states are no longer isolated). The homotopy stops at the first point
+  // past the kink (a tire's normal load zero); a corrector that cannot cross
+  // it (the step falls below min_step) is named the same way when the
+  // branch, followed again to just before that command time, ends with a
+  // tire below 2 % of its straight-running load.
+  const auto liftOff = [&](const SteadyStateResult& last, const Unloaded& u, double lambda, const std::string& how) {
+    return NamedOutcome("past_lift_off",
+                        "no steady state found on the branch from straight running past a wheel lift-off: " + u.tire +
+                            " = " + formatValue(u.fz) + " N (" + formatValue(u.fz0) +
+                            " N at straight running) at front steer " +
+                            (frontSteer ? formatValue(frontSteer(last.state) * 180 / SimTK::Pi)
+                                        : std::string("(unknown)")) +
+                            " deg (lateral acceleration " + formatValue(lateralOf(scene, solver, last.state)) +
+                            " m/s^2), at command time " + formatValue(lambda) + " s of " + formatValue(T) + " s (" +
+                            how + ")");
+  };
+  o.stop_if = [&](const ArclengthPoint& p) {
+    return findUnloaded(scene, solver.makeDrivenResult(p.x, p.lambda).state, r0.state, 0.0).tire.empty()
+               ? std::string()
+               : std::string("a wheel lifted off");
+  };
   ArclengthResult ar;
   try {
     ar = continueSteadyState(solver, r0, 0.0, setTime, T, false, o);
   } catch (const Error& e) {
-    // A wheel lifting off puts a kink into the branch (the tire's normal load
-    // reaches zero; past it the wheel hangs): the corrector cannot cross it
-    // and the step falls below min_step there. Named when the branch, followed
-    // again to just before that command time, ends with a tire unloaded.
     const std::string msg = e.what(), head = "the step fell below min_step", at = "at lambda = ";
     const auto p = msg.find(at);
     if (msg.find(head) == std::string::npos || p == std::string::npos) throw;
     const double stuck = std::stod(msg.substr(p + at.size()));
     ArclengthOptions ob = o;
     ob.lambda_max = stuck - 1e-3 * T;
+    ob.stop_if = nullptr;
     const ArclengthResult before = continueSteadyState(solver, r0, 0.0, setTime, T, false, ob);
     const SteadyStateResult last = solver.makeDrivenResult(before.points.back().x, before.points.back().lambda);
-    std::string tire;
-    double fz = 0, fz0 = 0;
-    for (const auto& n : scene.getOutputNames()) {
-      if (n.size() < 5 || n.compare(n.size() - 5, 5, ".Fz_N") != 0) continue;
-      const double f = scene.evalOutput(n, last.state), f0 = scene.evalOutput(n, r0.state);
-      if (f0 > 0 && f < 0.02 * f0 && (tire.empty() || f / f0 < fz / fz0)) tire = n, fz = f, fz0 = f0;
-    }
-    if (tire.empty()) throw;
-    throw NamedOutcome("past_lift_off",
-                       "no steady state found on the branch from straight running past a wheel lift-off: " + tire + " = " +
-                formatValue(fz) + " N (" + formatValue(fz0) + " N at straight running) at front steer " +
-                (frontSteer ? formatValue(frontSteer(last.state) * 180 / SimTK::Pi) : std::string("(unknown)")) +
-                " deg (lateral acceleration " + formatValue(lateralOf(scene, solver, last.state)) +
-                " m/s^2), at command time " + formatValue(before.points.back().lambda) + " s of " + formatValue(T) +
-                " s (the continuation does not cross the contact's kink: " + msg + ")");
+    const Unloaded u = findUnloaded(scene, last.state, r0.state, 0.02);
+    if (u.tire.empty()) throw;
+    throw liftOff(last, u, before.points.back().lambda, "the continuation does not cross the contact's kink: " + msg);
   }
   if (report) {
     report->arclength_steps = ar.steps;
@@ -94,11 +119,24 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   for (const auto& sp : ar.special) {
     if (sp.kind != "fold" || !(sp.point.lambda < T)) continue;
     const SteadyStateResult f = solver.makeDrivenResult(sp.point.x, sp.point.lambda);
+    // A fold at the contact's kink (the branch turns back where a wheel lifts
+    // off: its load at the located fold about 3e-8 of the straight-running
+    // one in the ch3 design sweep at 15 m/s) is the lift-off.
+    const Unloaded u = findUnloaded(scene, f.state, r0.state, 1e-5);
+    if (!u.tire.empty())
+      throw liftOff(f, u, sp.point.lambda, "a fold of the branch where the wheel lifts off, at the contact's kink");
     const double ay = lateralOf(scene, solver, f.state);
     throw NamedOutcome("beyond_fold", "no steady state on the branch from straight running: fold at front steer " +
                 (frontSteer ? formatValue(frontSteer(f.state) * 180 / SimTK::Pi) : std::string("(unknown)")) +
                 " deg (lateral acceleration " + formatValue(ay) + " m/s^2), at command time " +
                 formatValue(sp.point.lambda) + " s of " + formatValue(T) + " s");
+  }
+  // A fold before the lift-off is the branch's end (found first).
+  if (ar.stop_reason == "stopped") {
+    const ArclengthPoint& pt = ar.points.back();
+    const SteadyStateResult last = solver.makeDrivenResult(pt.x, pt.lambda);
+    throw liftOff(last, findUnloaded(scene, last.state, r0.state, 0.0), pt.lambda,
+                  "the first point of the branch past the contact's kink, the wheel hanging");
   }
   // The two neighbours of time T along the branch: the point at T from their
   // interpolation.

@@ -54,6 +54,8 @@ struct ArclengthSystem {
   std::function<std::vector<std::complex<double>>(const Eigen::VectorXd& x, double lambda)> eigenvalues;
 };
 
+struct ArclengthPoint;
+
 struct ArclengthOptions {
   double step = 0.01;             ///< first arclength step, lambda's unit (> 0)
   double min_step = 1e-6;         ///< smallest step before the continuation fails, lambda's unit
@@ -83,6 +85,10 @@ struct ArclengthOptions {
   /// Points past the stop_after_folds-th fold before stopping (at least 1:
   /// the point whose test function revealed it).
   int points_after_last_fold = 0;
+  /// Called at every accepted point after the start; a non-empty return (the
+  /// reason) ends the continuation at that point (kept as the last):
+  /// stop_reason "stopped", the reason in ArclengthResult::stop_message.
+  std::function<std::string(const ArclengthPoint&)> stop_if;
 };
 
 struct ArclengthPoint {
@@ -117,7 +123,8 @@ struct ArclengthResult {
   int jacobians = 0;             ///< system.jacobian calls (one per tangent, more where Newton retried)
   int residual_evaluations = 0;  ///< system.residual calls
   int quasi_newton_fallbacks = 0;  ///< steps the quasi-Newton corrector left to Newton
-  std::string stop_reason;   ///< "max_points", "lambda_range", "folds"
+  std::string stop_reason;   ///< "max_points", "lambda_range", "folds", "stopped" (stop_if)
+  std::string stop_message;  ///< stop_if's reason when stopped
 };
 
 /// Continues from a solution (x0, lambda0). Throws Error if the start does not
