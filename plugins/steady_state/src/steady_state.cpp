@@ -552,6 +552,12 @@ Eigen::MatrixXd SteadyStateSolver::calcDrivenJacobian(const Eigen::VectorXd& x, 
   return J;
 }
 
+SimTK::State SteadyStateSolver::getDrivenEulerState(const Eigen::VectorXd& x, double lambda) const {
+  applyDrive(lambda);
+  setUnknowns(x);
+  return se_;
+}
+
 SteadyStateResult SteadyStateSolver::makeDrivenResult(const Eigen::VectorXd& x, double lambda) const {
   applyDrive(lambda);
   const Eigen::VectorXd r = calcEquations(x);

@@ -2,7 +2,10 @@
 
 #include "vdyn/core/named_outcome.h"
 
+#include <algorithm>
 #include <cmath>
+#include <string>
+#include <vector>
 
 namespace vdyn {
 
@@ -18,22 +21,47 @@ double lateralOf(const Scene& scene, const SteadyStateSolver& solver, const SimT
   return b.getBodyAngularVelocity(s)[2] * std::hypot(v[0], v[1]);
 }
 
-/// The tire whose normal load (an output ending in ".Fz_N") at `at` is least
-/// relative to its straight-running value in `start`, if that is at most
-/// `fraction` of it: a wheel lifting off. Empty name when none is.
-struct Unloaded {
-  std::string tire;
-  double fz = 0, fz0 = 0;
-};
-Unloaded findUnloaded(const Scene& scene, const SimTK::State& at, const SimTK::State& start, double fraction) {
-  Unloaded u;
-  for (const auto& n : scene.getOutputNames()) {
-    if (n.size() < 5 || n.compare(n.size() - 5, 5, ".Fz_N") != 0) continue;
-    const double f = scene.evalOutput(n, at), f0 = scene.evalOutput(n, start);
-    if (f0 > 0 && f <= fraction * f0 && (u.tire.empty() || f / f0 < u.fz / u.fz0)) u.tire = n, u.fz = f, u.fz0 = f0;
+/// The tires' normal loads (the outputs ending in ".Fz_N") at straight
+/// running, and the search for an unloaded one.
+class TireLoads {
+ public:
+  struct Unloaded {
+    std::string tire;  ///< empty: none
+    double fz = 0, fz0 = 0;
+  };
+  TireLoads(const Scene& scene, const SimTK::State& straight) : scene_(scene) {
+    for (const auto& n : scene.getOutputNames())
+      if (n.size() >= 5 && n.compare(n.size() - 5, 5, ".Fz_N") == 0) {
+        const double f0 = scene.evalOutput(n, straight);
+        if (f0 > 0) tires_.push_back({&scene.getOutput(n), n, f0});
+      }
   }
-  return u;
-}
+  /// The tire least loaded at `at` relative to straight running, if that is
+  /// at most `fraction` of its straight-running load (one realization).
+  Unloaded find(const SimTK::State& at, double fraction) const {
+    Unloaded u;
+    if (tires_.empty()) return u;
+    SimTK::State s = at;
+    SimTK::Stage stage = SimTK::Stage::Position;
+    for (const Tire& t : tires_) stage = std::max(stage, t.output->stage);
+    scene_.getSystem().realize(s, stage);
+    for (const Tire& t : tires_) {
+      const double f = t.output->eval(s);
+      if (f <= fraction * t.fz0 && (u.tire.empty() || f / t.fz0 < u.fz / u.fz0)) u = {t.name, f, t.fz0};
+    }
+    return u;
+  }
+
+ private:
+  struct Tire {
+    const Output* output;
+    std::string name;
+    double fz0;
+  };
+  const Scene& scene_;
+  std::vector<Tire> tires_;
+};
+using Unloaded = TireLoads::Unloaded;
 
 }  // namespace
 
@@ -86,8 +114,9 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
                             " m/s^2), at command time " + formatValue(lambda) + " s of " + formatValue(T) + " s (" +
                             how + ")");
   };
+  const TireLoads loads(scene, r0.state);
   o.stop_if = [&](const ArclengthPoint& p) {
-    return findUnloaded(scene, solver.makeDrivenResult(p.x, p.lambda).state, r0.state, 0.0).tire.empty()
+    return loads.find(solver.getDrivenEulerState(p.x, p.lambda), 0.0).tire.empty()
                ? std::string()
                : std::string("a wheel lifted off");
   };
@@ -104,7 +133,7 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
     ob.stop_if = nullptr;
     const ArclengthResult before = continueSteadyState(solver, r0, 0.0, setTime, T, false, ob);
     const SteadyStateResult last = solver.makeDrivenResult(before.points.back().x, before.points.back().lambda);
-    const Unloaded u = findUnloaded(scene, last.state, r0.state, 0.02);
+    const Unloaded u = loads.find(last.state, 0.02);
     if (u.tire.empty()) throw;
     throw liftOff(last, u, before.points.back().lambda, "the continuation does not cross the contact's kink: " + msg);
   }
@@ -122,7 +151,7 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
     // A fold at the contact's kink (the branch turns back where a wheel lifts
     // off: its load at the located fold about 3e-8 of the straight-running
     // one in the ch3 design sweep at 15 m/s) is the lift-off.
-    const Unloaded u = findUnloaded(scene, f.state, r0.state, 1e-5);
+    const Unloaded u = loads.find(f.state, 1e-5);
     if (!u.tire.empty())
       throw liftOff(f, u, sp.point.lambda, "a fold of the branch where the wheel lifts off, at the contact's kink");
     const double ay = lateralOf(scene, solver, f.state);
@@ -135,7 +164,7 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
   if (ar.stop_reason == "stopped") {
     const ArclengthPoint& pt = ar.points.back();
     const SteadyStateResult last = solver.makeDrivenResult(pt.x, pt.lambda);
-    throw liftOff(last, findUnloaded(scene, last.state, r0.state, 0.0), pt.lambda,
+    throw liftOff(last, loads.find(last.state, 0.0), pt.lambda,
                   "the first point of the branch past the contact's kink, the wheel hanging");
   }
   // The two neighbours of time T along the branch: the point at T from their

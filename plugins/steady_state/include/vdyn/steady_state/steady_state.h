@@ -248,6 +248,10 @@ class SteadyStateSolver {
   Eigen::VectorXd calcDrivenEquations(const Eigen::VectorXd& x, double lambda) const;
   Eigen::MatrixXd calcDrivenJacobian(const Eigen::VectorXd& x, double lambda, const Eigen::VectorXd& r) const;
   SteadyStateResult makeDrivenResult(const Eigen::VectorXd& x, double lambda) const;
+  /// The Euler-angle state at (x, lambda) (a copy of the workspace, lambda's
+  /// model left set): what an output of a point needs, without the
+  /// quaternion form's conversion or a residual evaluation.
+  SimTK::State getDrivenEulerState(const Eigen::VectorXd& x, double lambda) const;
   /// True when equations r meet every tolerance of the options and conditions.
   bool meetsTolerances(const Eigen::VectorXd& r) const;
   const Eigen::VectorXd& getUnknownScales() const { return xScale_; }    ///< typical sizes of the unknowns
