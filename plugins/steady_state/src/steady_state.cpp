@@ -615,6 +615,16 @@ struct Reduction {
     for (int i : us) s.updU()[i] = r[k++];
     for (int i = 0; i < nz; ++i) s.updZ()[i] = r[k++];
   }
+  /// The state entry that reduced coordinate j is at zero yaw, when it is a
+  /// single speed (base velocities, kept speeds) or z: 'u' or 'z' and its
+  /// index; 'q' (index -1) for the coordinates (toState writes those).
+  std::pair<char, int> entry(int j) const {
+    const int nb = base.isValid() ? 9 : 0, nq = int(qs.size()), nu = int(us.size());
+    if (nb && j >= 3 && j < 9) return {'u', bu0 + j - 3};
+    if (j >= nb + nq && j < nb + nq + nu) return {'u', us[j - nb - nq]};
+    if (j >= nb + nq + nu) return {'z', j - nb - nq - nu};
+    return {'q', -1};
+  }
   /// d r / dt from Simbody's forward dynamics at a state with zero yaw.
   Eigen::VectorXd rate(SimTK::State& s) const {
     system->realize(s, SimTK::Stage::Acceleration);
@@ -736,15 +746,35 @@ LinearModel SteadyStateSolver::calcLinearModel(const SteadyStateResult& steady, 
     for (int i = 0; i < st.getNUErr(); ++i) c[st.getNQErr() + i] = st.getUErr()[i];
     return c;
   };
+  // A speed's or z's column perturbs that entry alone (at zero yaw the
+  // reduced base velocities are the base's speeds), so Simbody keeps the
+  // Position stage: the same numbers as through toState, without the
+  // coordinates' realization.
+  const double hc = 1e-7;
   for (int j = 0; j < N; ++j) {
-    const double h = 1e-7;
+    if (red.entry(j).first != 'q') continue;
     Eigen::VectorXd rp = r0, rm = r0;
-    rp[j] += h;
-    rm[j] -= h;
+    rp[j] += hc;
+    rm[j] -= hc;
     red.toState(rp, s);
     const Eigen::VectorXd cp = constraintErrors(s);
     red.toState(rm, s);
-    C.col(j) = (cp - constraintErrors(s)) / (2 * h);
+    C.col(j) = (cp - constraintErrors(s)) / (2 * hc);
+  }
+  red.toState(r0, s);
+  for (int j = 0; j < N; ++j) {
+    const auto [kind, i] = red.entry(j);
+    if (kind == 'q') continue;
+    const double v0 = r0[j];
+    auto set = [&](double v) {
+      if (kind == 'u') s.updU()[i] = v;
+      else s.updZ()[i] = v;
+    };
+    set(v0 + hc);
+    const Eigen::VectorXd cp = constraintErrors(s);
+    set(v0 - hc);
+    C.col(j) = (cp - constraintErrors(s)) / (2 * hc);
+    set(v0);
   }
   Eigen::MatrixXd T;
   Eigen::MatrixXd Cpinv = Eigen::MatrixXd::Zero(N, nc);  // pseudo-inverse of C
