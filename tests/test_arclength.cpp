@@ -310,6 +310,7 @@ TEST(Arclength, QuasiNewtonCorrectorMeetsTheSameTolerancesWithFewerJacobians) {
     for (const auto& p : r->points) EXPECT_LE(s.residual(p.x, p.lambda).lpNorm<Eigen::Infinity>(), 1e-12);
   }
   EXPECT_EQ(n.quasi_newton_fallbacks, 0);
+  EXPECT_EQ(n.jacobians, n.steps + 1 + n.corrector_iterations);  // a tangent per point, one per Newton iteration
   // Every Jacobian beyond one per tangent is a Newton retry's.
   EXPECT_GE(q.jacobians, q.steps + 1);
   EXPECT_LE(q.jacobians - (q.steps + 1), o.max_corrector_iterations * q.quasi_newton_fallbacks);
