@@ -22,6 +22,7 @@
 #include <string>
 
 #include "test_util.h"
+#include "vdyn/core/named_outcome.h"
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 #include "vdyn/vehicles/standard_registry.h"
@@ -242,5 +243,48 @@ TEST(LimitSweep, FoldInFrontSteerAgreesWithTheSlowRampSteerDeparture) {
     EXPECT_NEAR(ay, foldAy, 0.02 * foldAy);
     EXPECT_LT(dDeg - foldDeg, 1.0);  // the passage's delay, command angle past the fold's (deg)
     EXPECT_GT(s.at("events")[0].at("time_s").get<double>(), tDep);
+  }
+}
+
+// A wheel lift-off on the branch from straight running (issue 24: the
+// homotopy's quasi-Newton corrector crosses the contact's kink that Newton
+// stalled at, into states with the inner front wheel hanging and its spin
+// free). Two rows of the 15 m/s design sweep with soft rear springs (4.58e4
+// N/m), mu_max 0.7: with the stiffest-but-one front springs (1.5572e5 N/m)
+// the branch's first point past the kink has the inner front tire unloaded
+// (0 N) at front steer 3.4836 deg, before the asked 4 deg; with 1.2824e5 N/m
+// the branch folds back exactly at the kink (3.5627 deg, the tire's load
+// there ~1e-4 N of 1923 N): both are the named outcome past_lift_off, not a
+// fold and not a failed run.
+TEST(LimitSweep, AWheelLiftOffOnTheBranchIsNamedWhereItHappens) {
+  auto outcomeOf = [](double frontSpring) {
+    std::vector<Override> o = at15();
+    o.push_back({"vehicle.overrides.tire.params.mu_max", 0.7});
+    o.push_back({"vehicle.overrides.tire.params.mu_min", 0.525});
+    o.push_back({"vehicle.overrides.axles.rear.suspension.spring.stiffness_N_per_m", 4.58e4});
+    o.push_back({"vehicle.overrides.axles.front.suspension.spring.stiffness_N_per_m", frontSpring});
+    try {
+      runScene(SceneDescription::fromFile("scenes/ch3_steady_state.json", standardRegistry(), o), noFiles());
+    } catch (const NamedOutcome& e) {
+      std::printf("front spring %g N/m: %s: %s\n", frontSpring, e.status().c_str(), e.what());
+      return std::make_pair(e.status(), std::string(e.what()));
+    }
+    return std::make_pair(std::string("ok"), std::string());
+  };
+  const std::string head = "no steady state found on the branch from straight running past a wheel lift-off: ";
+  {
+    const auto [status, msg] = outcomeOf(1.5572e5);
+    EXPECT_EQ(status, "past_lift_off");
+    EXPECT_EQ(msg.rfind(head + "tire_lf.Fz_N = 0 N (", 0), 0u) << msg;
+    EXPECT_NEAR(numberAfter(msg, "at front steer "), 3.4836, 1e-3) << msg;
+    EXPECT_NE(msg.find("the first point of the branch past the contact's kink"), std::string::npos) << msg;
+  }
+  {
+    const auto [status, msg] = outcomeOf(1.2824e5);
+    EXPECT_EQ(status, "past_lift_off");
+    EXPECT_EQ(msg.rfind(head + "tire_lf.Fz_N = ", 0), 0u) << msg;
+    EXPECT_LT(numberAfter(msg, "tire_lf.Fz_N = "), 1e-2) << msg;  // N, of 1923 N at straight running
+    EXPECT_NEAR(numberAfter(msg, "at front steer "), 3.5627, 1e-3) << msg;
+    EXPECT_NE(msg.find("a fold of the branch where the wheel lifts off"), std::string::npos) << msg;
   }
 }
