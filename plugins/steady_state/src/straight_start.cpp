@@ -36,12 +36,13 @@ class TireLoads {
         if (f0 > 0) tires_.push_back({&scene.getOutput(n), n, f0});
       }
   }
-  /// The tire least loaded at `at` relative to straight running, if that is
-  /// at most `fraction` of its straight-running load (one realization).
-  Unloaded find(const SimTK::State& at, double fraction) const {
+  bool empty() const { return tires_.empty(); }
+  /// The tire least loaded in state `s` (taken by value: it is realized)
+  /// relative to straight running, if that is at most `fraction` of its
+  /// straight-running load (one realization).
+  Unloaded find(SimTK::State s, double fraction) const {
     Unloaded u;
     if (tires_.empty()) return u;
-    SimTK::State s = at;
     SimTK::Stage stage = SimTK::Stage::Position;
     for (const Tire& t : tires_) stage = std::max(stage, t.output->stage);
     scene_.getSystem().realize(s, stage);
@@ -115,11 +116,12 @@ SteadyStateResult solveFromStraightRunning(SteadyStateSolver& solver, const Scen
                             how + ")");
   };
   const TireLoads loads(scene, r0.state);
-  o.stop_if = [&](const ArclengthPoint& p) {
-    return loads.find(solver.getDrivenEulerState(p.x, p.lambda), 0.0).tire.empty()
-               ? std::string()
-               : std::string("a wheel lifted off");
-  };
+  if (!loads.empty())
+    o.stop_if = [&](const ArclengthPoint& p) {
+      return loads.find(solver.getDrivenEulerState(p.x, p.lambda), 0.0).tire.empty()
+                 ? std::string()
+                 : std::string("a wheel lifted off");
+    };
   ArclengthResult ar;
   try {
     ar = continueSteadyState(solver, r0, 0.0, setTime, T, false, o);
