@@ -207,4 +207,24 @@ SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, 
   return res;
 }
 
+void runSweepMpiJob(SweepMpiJob& job, const char* program) {
+  if (!job.sweep || !job.run) throw Error("runSweepMpiJob: the job has no sweep or no run function");
+  int argc = 0;
+  char** argv = nullptr;
+  MpiSession mpi(&argc, &argv);
+  job.manager = mpi.rank() == 0;
+  SweepOptions o = job.options;
+  if (!job.manager) o.progress = nullptr;
+  try {
+    job.result = runSweepMpi(*job.sweep, *job.run, o);
+    if (job.manager && job.on_manager) job.on_manager(job.result);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "%s: error (MPI rank %d): %s\n", program, mpi.rank(), e.what());
+    if (mpi.size() > 1) MpiSession::abort(1);
+    throw;
+  }
+}
+
 }  // namespace vdyn
+
+void vdyn_run_sweep_mpi_job(vdyn::SweepMpiJob* job, const char* program) { vdyn::runSweepMpiJob(*job, program); }

@@ -25,12 +25,36 @@
 #include "vdyn/core/scene_file.h"
 #include "vdyn/core/sweep.h"
 #ifdef VDYN_HAVE_MPI
+#include <dlfcn.h>
+
 #include "vdyn/core/sweep_mpi.h"
 #endif
 
 namespace vdyn::cli {
 
 namespace {
+
+#ifdef VDYN_HAVE_MPI
+/// The MPI runner's entry (vdyn_sweep_mpi.h: vdyn_run_sweep_mpi_job), from
+/// the library opened on the first --mpi run only: vdyn is not linked to
+/// it, so a process without --mpi does not load Open MPI's seven libraries
+/// (about 2 ms of user CPU per start; docs/benchmarks.md). The library is the
+/// build's own (its soname, VDYN_SWEEP_MPI_LIBRARY, found along vdyn's
+/// run path: build/lib, or the installed lib folder); RTLD_GLOBAL, since Open
+/// MPI's components, which it opens in turn, resolve symbols of libmpi.
+using SweepMpiEntry = void (*)(SweepMpiJob*, const char*);
+SweepMpiEntry loadSweepMpiRunner() {
+  void* lib = dlopen(VDYN_SWEEP_MPI_LIBRARY, RTLD_NOW | RTLD_GLOBAL);
+  if (!lib)
+    throw Error(std::string("--mpi: the MPI sweep runner ") + VDYN_SWEEP_MPI_LIBRARY + " could not be loaded: " +
+                dlerror());
+  dlerror();
+  void* entry = dlsym(lib, "vdyn_run_sweep_mpi_job");
+  if (!entry)
+    throw Error(std::string("--mpi: ") + VDYN_SWEEP_MPI_LIBRARY + " has no vdyn_run_sweep_mpi_job: " + dlerror());
+  return reinterpret_cast<SweepMpiEntry>(entry);
+}
+#endif
 
 /// The last key of a (checked) key path with any indices after it: "steps[1]" of "a.steps[1]".
 std::string lastSegment(const std::string& path) {
@@ -158,20 +182,17 @@ int sweepCommand(const std::vector<std::string>& args) {
   bool manager = true;
   if (useMpi) {
 #ifdef VDYN_HAVE_MPI
-    int argc = 0;
-    char** argv = nullptr;
-    MpiSession mpi(&argc, &argv);
-    manager = mpi.rank() == 0;
-    so.threads = vm.count("threads") ? vm["threads"].as<int>() : 1;
-    if (manager && !quiet) so.progress = sweepProgressPrinter("vdyn sweep");
-    try {
-      r = runSweepMpi(sweep, run, so);
-      if (manager && !vm.count("no-plots")) renderSweepPlots(sweep, r, out);
-    } catch (const std::exception& e) {
-      std::fprintf(stderr, "vdyn sweep: error (MPI rank %d): %s\n", mpi.rank(), e.what());
-      if (mpi.size() > 1) MpiSession::abort(1);  // the other ranks would wait for it forever
-      throw;
-    }
+    const SweepMpiEntry runMpi = loadSweepMpiRunner();
+    SweepMpiJob job;
+    job.sweep = &sweep;
+    job.run = &run;
+    job.options = so;
+    job.options.threads = vm.count("threads") ? vm["threads"].as<int>() : 1;
+    if (!quiet) job.options.progress = sweepProgressPrinter("vdyn sweep");
+    if (!vm.count("no-plots")) job.on_manager = [&](const SweepResult& res) { renderSweepPlots(sweep, res, out); };
+    runMpi(&job, "vdyn sweep");
+    r = std::move(job.result);
+    manager = job.manager;
 #endif
   } else {
     so.threads = vm.count("threads") ? vm["threads"].as<int>() : int(std::max(1u, std::thread::hardware_concurrency()));

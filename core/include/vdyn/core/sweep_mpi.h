@@ -15,6 +15,8 @@
 // (SweepDescription::fingerprint). Rows are byte-identical to the thread
 // runner's: a row travels as its journal line, which the thread runner's rows
 // also pass through.
+#include <functional>
+
 #include "vdyn/core/sweep.h"
 
 namespace vdyn {
@@ -42,4 +44,33 @@ class MpiSession {
 /// the runs this rank did).
 SweepResult runSweepMpi(const SweepDescription& d, const SweepRunFunction& run, const SweepOptions& options);
 
+/// A whole MPI sweep for a program that loads this library only when asked
+/// (`vdyn sweep --mpi` opens it with dlopen, so a process without --mpi does
+/// not load Open MPI's libraries: about 2 ms of user CPU per start, see
+/// docs/benchmarks.md): the session, the runs, and `on_manager` on rank 0.
+struct SweepMpiJob {
+  const SweepDescription* sweep = nullptr;
+  const SweepRunFunction* run = nullptr;
+  /// options.progress is kept on rank 0 only.
+  SweepOptions options;
+  /// After the runs, on rank 0 (the sweep's plots); may be empty.
+  std::function<void(const SweepResult&)> on_manager;
+  /// Set by runSweepMpiJob: rank 0's full result (other ranks: no rows), and
+  /// whether this process is rank 0.
+  SweepResult result;
+  bool manager = true;
+};
+
+/// Starts an MpiSession, runs runSweepMpi and job.on_manager. An error on a
+/// rank is printed there ("<program>: error (MPI rank R): ...", `program`
+/// names the caller) and, with more than one rank, ends every rank
+/// (MpiSession::abort: the others would wait for it forever); with one rank
+/// it is rethrown.
+void runSweepMpiJob(SweepMpiJob& job, const char* program);
+
 }  // namespace vdyn
+
+/// runSweepMpiJob with C linkage, the symbol a program looks up after dlopen
+/// of this library (its soname: the build's VDYN_SWEEP_MPI_LIBRARY).
+extern "C" __attribute__((visibility("default"))) void vdyn_run_sweep_mpi_job(vdyn::SweepMpiJob* job,
+                                                                             const char* program);
