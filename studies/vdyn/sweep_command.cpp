@@ -50,8 +50,11 @@ SweepMpiEntry loadSweepMpiRunner() {
                 dlerror());
   dlerror();
   void* entry = dlsym(lib, "vdyn_run_sweep_mpi_job");
-  if (!entry)
-    throw Error(std::string("--mpi: ") + VDYN_SWEEP_MPI_LIBRARY + " has no vdyn_run_sweep_mpi_job: " + dlerror());
+  if (!entry) {
+    const char* why = dlerror();
+    throw Error(std::string("--mpi: ") + VDYN_SWEEP_MPI_LIBRARY + " has no vdyn_run_sweep_mpi_job: " +
+                (why ? why : "the symbol is null"));
+  }
   return reinterpret_cast<SweepMpiEntry>(entry);
 }
 #endif
