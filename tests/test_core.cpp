@@ -224,6 +224,29 @@ TEST(Stiffness, RkMersonLimitAndTheJacobianOfADampedOscillator) {
   bad(0, 1) = std::nan("");
   EXPECT_EQ(errorOf([&] { calcEigenvalues(bad); }),
             "stiffness: the Jacobian of the state derivative has a non-finite entry");
+
+  // Mode shapes (calcModeShape), in closed form: the slider's modes are
+  // (x, x') = (1, r) e^(r t), so |x| / |x'| = 1 / |r|; a mode on one
+  // coordinate of a block-diagonal matrix is that coordinate alone; the pair
+  // a +- b i of [[a, -b], [b, a]] has the eigenvector (1, -+i), entries equal.
+  const Eigen::MatrixXd Js = calcStateDerivativeJacobian(system, s);
+  for (const C r : eig) {
+    const Eigen::VectorXd shape = calcModeShape(Js, r);
+    EXPECT_NEAR(shape[1], 1.0, 1e-12) << r;
+    EXPECT_NEAR(shape[0], 1.0 / std::abs(r.real()), 1e-6 / std::abs(r.real())) << r;
+  }
+  Eigen::MatrixXd block = Eigen::MatrixXd::Zero(3, 3);
+  block(0, 0) = -2, block(0, 1) = 1, block(1, 1) = -3, block(2, 2) = -400;
+  const Eigen::VectorXd fast = calcModeShape(block, C(-400, 0));
+  EXPECT_EQ(fast[2], 1.0);
+  EXPECT_LT(fast.head(2).maxCoeff(), 1e-12);
+  Eigen::MatrixXd rot(2, 2);
+  rot << -20, -112, 112, -20;
+  const Eigen::VectorXd osc = calcModeShape(rot, C(-20, 112));
+  EXPECT_NEAR(osc[0], 1.0, 1e-12);
+  EXPECT_NEAR(osc[1], 1.0, 1e-12);
+  EXPECT_EQ(errorOf([&] { calcModeShape(bad, C(1, 0)); }),
+            "stiffness: the Jacobian of the state derivative has a non-finite entry");
 }
 
 // CpodesStepper (CPodes driven by vdyn, its Jacobian through the mirrored

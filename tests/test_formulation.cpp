@@ -472,6 +472,8 @@ TEST(Formulation, AutoIntegratorGoesOnWithCpodesWhereRkMersonIsHeldByStability) 
   EXPECT_EQ(choice.rfind("rk_merson, then cpodes from t = ", 0), 0u) << choice;
   EXPECT_NE(choice.find("stability limit 0.0089"), std::string::npos) << choice;
   EXPECT_NE(choice.find("(eigenvalue -39"), std::string::npos) << choice;
+  // The mode that holds RK Merson: the wheels' spin (calcModeShape), named by body.
+  EXPECT_NE(choice.find("; its mode's largest entries: lf.wheel u0 1, "), std::string::npos) << choice;
   const double r0 = ref.result.summary["final"][k].get<double>();
   EXPECT_NEAR(au.result.summary["final"][k].get<double>(), r0, 3e-5 * std::abs(r0));
   const long nAuto = runAuto["realizations"].get<long>();
@@ -543,6 +545,12 @@ TEST(Formulation, AutoIntegratorStaysOnCpodesThroughTheChapter8LaneChange) {
   const std::string choice = ra["integrator_choice"].get<std::string>();
   EXPECT_EQ(choice.rfind("rk_merson, then cpodes from t = ", 0), 0u) << choice;
   EXPECT_EQ(choice.find("back to rk_merson"), std::string::npos) << choice;
+  // The mode near -217 1/s is the four wheels' spin and nothing else (docs/benchmarks.md, stop 44).
+  const std::size_t at = choice.find("; its mode's largest entries: ");
+  ASSERT_NE(at, std::string::npos) << choice;
+  const std::string entries = choice.substr(at, choice.find(')', at) - at);
+  for (const char* w : {"lf.wheel u0", "rf.wheel u0", "lr.wheel u0", "rr.wheel u0"})
+    EXPECT_NE(entries.find(w), std::string::npos) << w << " in " << entries;
   const long nAuto = ra["realizations"].get<long>(), nRk = rk.result.summary["run"]["realizations"].get<long>();
   EXPECT_LT(nAuto, 0.7 * nRk) << "auto " << nAuto << ", rk_merson " << nRk;
   for (const char* k : {"chassis.y_m", "path_control.e1_m"})

@@ -66,6 +66,40 @@ double positionConstraintError(const SimTK::State& state) {
 
 namespace {
 
+// The entries of a mode shape (calcModeShape: y = (q, u, z) in Simbody's
+// order, largest 1) of at least 0.3, at most four, largest first, named by
+// the scene's bodies: "front_left.wheel u0 1, front_right.wheel u0 0.73";
+// z entries as "z[k]".
+std::string describeMode(const Scene& scene, const SimTK::State& state, const Eigen::VectorXd& shape) {
+  const int nq = state.getNQ(), nu = state.getNU();
+  std::vector<int> order;
+  for (int i = 0; i < int(shape.size()); ++i)
+    if (shape[i] >= 0.3) order.push_back(i);
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return shape[a] > shape[b]; });
+  if (order.size() > 4) order.resize(4);
+  const std::vector<std::string> names = scene.getBodyNames();
+  std::string out;
+  for (const int i : order) {
+    std::string what;
+    for (const std::string& name : names) {
+      const SimTK::MobilizedBody& b = scene.getBody(name);
+      const int first = i < nq ? int(b.getFirstQIndex(state)) : int(b.getFirstUIndex(state));
+      const int count = i < nq ? b.getNumQ(state) : b.getNumU(state);
+      const int k = (i < nq ? i : i - nq) - first;
+      if (i < nq + nu && k >= 0 && k < count) {
+        what = name + (i < nq ? " q" : " u") + std::to_string(k);
+        break;
+      }
+    }
+    if (what.empty()) what = i < nq ? "q[" + std::to_string(i) + "]" : i < nq + nu ? "u[" + std::to_string(i - nq) + "]"
+                                                                                : "z[" + std::to_string(i - nq - nu) + "]";
+    char v[24];
+    std::snprintf(v, sizeof v, " %.2g", shape[i]);
+    out += (out.empty() ? "" : ", ") + what + v;
+  }
+  return out;
+}
+
 // The run's integrator: one of Simbody's (SimTK::Integrator, every method but
 // cpodes) or CPodes as vdyn drives it (CpodesStepper), behind the calls the
 // loop below makes. Both return after every internal step; reports are
@@ -287,9 +321,11 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       long evaluations = 0;
       std::complex<double> lambda;
       double hStable = 0;
+      std::string mode;  // the limiting mode's largest entries, named
       try {
         checkJacobian = calcStateDerivativeJacobian(scene.getSystem(), adv, &evaluations);
         hStable = calcRkMersonStabilityLimit(calcEigenvalues(checkJacobian), &lambda);
+        if (std::isfinite(hStable)) mode = describeMode(scene, adv, calcModeShape(checkJacobian, lambda));
       } catch (const std::exception& e) {
         // A diagnostic does not end a run: RK Merson goes on, unchecked, and the summary says why.
         char at[40];
@@ -308,13 +344,14 @@ RunSummary simulate(const Scene& scene, SimTK::State& state, const SimulationSet
       const bool held = hHeld >= 0.8 * hStable && -lambda.real() >= 0.7 * std::abs(lambda);
       std::snprintf(buf, sizeof buf,
                     "the largest of the last %d steps %.3g s at t = %.6g s, RK Merson's stability limit %.3g s "
-                    "(eigenvalue %.4g%+.4gi 1/s)",
+                    "(eigenvalue %.4g%+.4gi 1/s",
                     kRecent, hHeld, adv.getTime(), hStable, lambda.real(), lambda.imag());
+      const std::string limit = std::string(buf) + (mode.empty() ? "" : "; its mode's largest entries: " + mode) + ")";
       char at[40];
       std::snprintf(at, sizeof at, "%.6g", adv.getTime());
-      sum.integrator_choice = held ? std::string("rk_merson, then cpodes from t = ") + at + " s (" + buf +
+      sum.integrator_choice = held ? std::string("rk_merson, then cpodes from t = ") + at + " s (" + limit +
                                          ": held by stability)"
-                                   : std::string("rk_merson (") + buf + ")";
+                                   : std::string("rk_merson (") + limit + ")";
       return held;
     };
     // After the switch CPodes must not spend more evaluations than RK Merson's

@@ -66,6 +66,25 @@ std::vector<std::complex<double>> calcEigenvalues(const Eigen::MatrixXd& jacobia
   return std::vector<std::complex<double>>(v.data(), v.data() + v.size());
 }
 
+Eigen::VectorXd calcModeShape(const Eigen::MatrixXd& jacobian, std::complex<double> lambda) {
+  if (!jacobian.allFinite()) throw Error("stiffness: the Jacobian of the state derivative has a non-finite entry");
+  const Eigen::Index n = jacobian.rows();
+  // Shifted off the eigenvalue by a relative 1e-10 so that the LU has no
+  // exact zero pivot; the solve then amplifies the eigenvector by ~1e10.
+  const std::complex<double> mu = lambda + 1e-10 * std::max(1.0, std::abs(lambda));
+  Eigen::MatrixXcd A = jacobian.cast<std::complex<double>>();
+  A.diagonal().array() -= mu;
+  const Eigen::PartialPivLU<Eigen::MatrixXcd> lu(A);
+  Eigen::VectorXcd x = Eigen::VectorXcd::Ones(n);
+  for (int k = 0; k < 2; ++k) {
+    x = lu.solve(x);
+    const double m = x.cwiseAbs().maxCoeff();
+    if (!(m > 0) || !std::isfinite(m)) return Eigen::VectorXd::Zero(n);
+    x /= m;
+  }
+  return x.cwiseAbs();
+}
+
 std::complex<double> calcRkMersonStabilityFunction(std::complex<double> z) {
   // The stages of RungeKuttaMersonIntegratorRep::attemptODEStep with h = 1,
   // f(y) = (z / h) y, y0 = 1.

@@ -37,6 +37,12 @@ void calcStateDerivativeJacobianColumns(const SimTK::System& system, SimTK::Stat
 /// finite or the QR iterations do not converge.
 std::vector<std::complex<double>> calcEigenvalues(const Eigen::MatrixXd& jacobian);
 
+/// The shape of the mode of `jacobian` (n x n) with eigenvalue `lambda` (1/s,
+/// one of calcEigenvalues' values): |x_i| / max_j |x_j| for its eigenvector x
+/// (size n, largest entry 1), by two steps of inverse iteration on
+/// J - lambda I (complex LU). Throws Error if the matrix has a non-finite entry.
+Eigen::VectorXd calcModeShape(const Eigen::MatrixXd& jacobian, std::complex<double> lambda);
+
 /// Stability function R(z) of Simbody's RK Merson step (its five stages and its
 /// propagated fourth-order solution, SimTKmath RungeKuttaMersonIntegrator.cpp)
 /// for y' = lambda y, z = h lambda: y1 = R(z) y0.
