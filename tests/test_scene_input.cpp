@@ -211,6 +211,26 @@ TEST(DerivedScene, CheckResolvedPrintsThePluginList) {
   EXPECT_NE(r.out.find("\"force_N\": ["), std::string::npos);  // the resolved JSON
 }
 
+// A run's summary.json records what ran: the scene file and its plugins as
+// resolved, so a plugin inherited from the base (here the speed hold) is on
+// record; vdyn run prints the same list.
+TEST(DerivedScene, TheRunSummaryRecordsTheResolvedPlugins) {
+  derivedScene("summary_plugins", R"("plugins": [{"name": "rear_steer", "remove": true},
+      {"type": "body_force", "name": "push", "attach": "chassis", "force_N": [0, 100, 0]}],
+      "analysis": {"type": "transient", "t_end_s": 0.01, "report_interval_s": 0})");
+  const std::string d = std::string(VDYN_TEST_OUT_DIR) + "/input_summary_plugins";
+  const Ran r = runVdyn("run '" + d + "/derived.json' --no-plots --out '" + d + "/out'", d);
+  ASSERT_EQ(r.rc, 0) << r.err;
+  EXPECT_NE(r.out.find("  plugins: front_steer (steering), speed_hold (speed_hold), push (body_force)\n"),
+            std::string::npos)
+      << r.out;
+  std::ifstream in(d + "/out/summary.json");
+  const Json summary = Json::parse(in);
+  EXPECT_EQ(summary["scene_file"], d + "/derived.json");
+  EXPECT_EQ(summary["plugins"], Json::parse(R"([{"name": "front_steer", "type": "steering"},
+      {"name": "speed_hold", "type": "speed_hold"}, {"name": "push", "type": "body_force"}])"));
+}
+
 // --- consistency checks before a run ----------------------------------------------
 TEST(Consistency, SpeedHoldAgainstInitialSpeedIsNamedByCheckAndRun) {
   const std::string d = freshDir("speed_hold");

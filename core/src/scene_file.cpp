@@ -441,6 +441,14 @@ SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& opt
   const AnalysisContext ctx{scene, built, options.out_dir, options.progress, animation.get()};
   AnalysisResult r = built.analysis->run(ctx);
   Json summary = {{"scene", scene.name()}, {"analysis", built.analysis->type()}};
+  // What ran: the file and the scene's plugins as resolved (based_on merged,
+  // --set applied), so that one inherited from a base scene is on record.
+  if (!scene.path().empty()) summary["scene_file"] = scene.path();
+  Json plugins = Json::array();
+  if (scene.json().contains("plugins") && scene.json()["plugins"].is_array())
+    for (const Json& p : scene.json()["plugins"])
+      if (p.is_object()) plugins.push_back({{"name", p.value("name", std::string())}, {"type", p.value("type", std::string())}});
+  summary["plugins"] = plugins;
   for (auto it = r.summary.begin(); it != r.summary.end(); ++it) summary[it.key()] = it.value();
   if (animation) {
     if (animation->size() < 2)
