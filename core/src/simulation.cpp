@@ -68,8 +68,9 @@ namespace {
 
 // The entries of a mode shape (calcModeShape: y = (q, u, z) in Simbody's
 // order, largest 1) of at least 0.3, at most four, largest first, named by
-// the scene's bodies: "front_left.wheel u0 1, front_right.wheel u0 0.73";
-// z entries as "z[k]".
+// the scene's bodies: "lr.wheel u0 1, lf.wheel u0 0.73" (a q or u no named
+// body owns as "q[k]" or "u[k]"); z entries as "z[k]". Empty for an all-zero
+// shape.
 std::string describeMode(const Scene& scene, const SimTK::State& state, const Eigen::VectorXd& shape) {
   const int nq = state.getNQ(), nu = state.getNU();
   std::vector<int> order;

@@ -40,7 +40,8 @@ std::vector<std::complex<double>> calcEigenvalues(const Eigen::MatrixXd& jacobia
 /// The shape of the mode of `jacobian` (n x n) with eigenvalue `lambda` (1/s,
 /// one of calcEigenvalues' values): |x_i| / max_j |x_j| for its eigenvector x
 /// (size n, largest entry 1), by two steps of inverse iteration on
-/// J - lambda I (complex LU). Throws Error if the matrix has a non-finite entry.
+/// J - lambda I (complex LU); all zeros if the iteration breaks down (a
+/// non-finite or zero iterate). Throws Error if the matrix has a non-finite entry.
 Eigen::VectorXd calcModeShape(const Eigen::MatrixXd& jacobian, std::complex<double> lambda);
 
 /// Stability function R(z) of Simbody's RK Merson step (its five stages and its
