@@ -205,6 +205,14 @@ std::string SceneDescription::resolve(const std::string& name) const {
   return resolveDataPath(name, path_.empty() ? "./scene" : path_);
 }
 
+std::vector<std::pair<std::string, std::string>> SceneDescription::pluginNamesAndTypes() const {
+  std::vector<std::pair<std::string, std::string>> out;
+  if (json_->contains("plugins") && (*json_)["plugins"].is_array())
+    for (const Json& p : (*json_)["plugins"])
+      if (p.is_object()) out.emplace_back(p.value("name", std::string()), p.value("type", std::string()));
+  return out;
+}
+
 std::vector<std::string> SceneDescription::pluginLibraries() const {
   std::vector<std::string> libs;
   if (!json_->contains("plugin_libraries")) return libs;
@@ -445,9 +453,7 @@ SceneRun runSceneWithTables(const SceneDescription& scene, const RunOptions& opt
   // --set applied), so that one inherited from a base scene is on record.
   if (!scene.path().empty()) summary["scene_file"] = scene.path();
   Json plugins = Json::array();
-  if (scene.json().contains("plugins") && scene.json()["plugins"].is_array())
-    for (const Json& p : scene.json()["plugins"])
-      if (p.is_object()) plugins.push_back({{"name", p.value("name", std::string())}, {"type", p.value("type", std::string())}});
+  for (const auto& [name, type] : scene.pluginNamesAndTypes()) plugins.push_back({{"name", name}, {"type", type}});
   summary["plugins"] = plugins;
   for (auto it = r.summary.begin(); it != r.summary.end(); ++it) summary[it.key()] = it.value();
   if (animation) {

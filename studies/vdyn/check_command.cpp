@@ -26,10 +26,8 @@ int checkCommand(const std::vector<std::string>& args) {
     const Json& j = scene.json();
     std::printf("%s\n", j.dump(2).c_str());
     std::printf("vdyn check: %s: plugins:", scene.path().c_str());
-    if (j.contains("plugins") && j["plugins"].is_array())
-      for (const Json& p : j["plugins"])
-        std::printf(" %s (%s)", p.is_object() ? p.value("name", std::string("?")).c_str() : "?",
-                    p.is_object() ? p.value("type", std::string("?")).c_str() : "?");
+    for (const auto& [name, type] : scene.pluginNamesAndTypes())
+      std::printf(" %s (%s)", name.empty() ? "?" : name.c_str(), type.empty() ? "?" : type.c_str());
     std::printf("\n");
   }
   const std::vector<std::string> errors = checkScene(scene, registry);

@@ -49,12 +49,9 @@ int runCommand(const std::vector<std::string>& args) {
   for (auto it = summary.begin(); it != summary.end(); ++it)
     if (it.value().is_number()) std::printf("  %-32s %.10g\n", it.key().c_str(), it.value().get<double>());
   // The scene's plugins as resolved (a derived scene's inherited ones included).
-  if (summary.contains("plugins") && summary["plugins"].is_array() && !summary["plugins"].empty()) {
-    std::string list;
-    for (const Json& p : summary["plugins"])
-      list += (list.empty() ? "" : ", ") + p.value("name", std::string()) + " (" + p.value("type", std::string()) + ")";
-    std::printf("  plugins: %s\n", list.c_str());
-  }
+  std::string list;
+  for (const auto& [name, type] : scene.pluginNamesAndTypes()) list += (list.empty() ? "" : ", ") + name + " (" + type + ")";
+  if (!list.empty()) std::printf("  plugins: %s\n", list.c_str());
   // Regime events (a spin-out, a lift-off): a result of the run, never silent.
   if (summary.contains("events") && summary["events"].is_array())
     for (const Json& e : summary["events"]) std::printf("  event: %s\n", e.value("message", e.dump()).c_str());

@@ -106,6 +106,10 @@ class SceneDescription {
   std::string resolve(const std::string& name) const;
   /// "plugin_libraries", resolved.
   std::vector<std::string> pluginLibraries() const;
+  /// The scene's plugins as resolved (based_on merged, overrides applied), in
+  /// order: each entry's "name" and "type" ("" where absent; `vdyn check`
+  /// reports those entries).
+  std::vector<std::pair<std::string, std::string>> pluginNamesAndTypes() const;
 
   /// Builds the vehicle, adds every plugin, checks the outputs, makes the
   /// analysis and checks that every key was read. A fresh Simbody system each
